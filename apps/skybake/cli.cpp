@@ -1,0 +1,18 @@
+#include "cli.h"
+
+#include <charconv>
+
+namespace skybake::cli {
+
+void parse_size(const std::string& text, int& width, int& height, const char* flag) {
+    const auto x = text.find('x');
+    auto parse = [&](std::string_view s, int& out) {
+        const auto r = std::from_chars(s.data(), s.data() + s.size(), out);
+        return r.ec == std::errc() && r.ptr == s.data() + s.size() && out > 0 && out <= 16384;
+    };
+    if (x == std::string::npos || !parse(std::string_view(text).substr(0, x), width) ||
+        !parse(std::string_view(text).substr(x + 1), height))
+        throw Error(fmt::format("bad size '{}': expected WIDTHxHEIGHT, each 1 to 16384", text), flag);
+}
+
+} // namespace skybake::cli

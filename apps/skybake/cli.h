@@ -1,0 +1,39 @@
+// Shared plumbing for the skybake sub-commands.
+//
+// Each sub-command lives in its own file and exposes one function,
+// `void add_<group>_<name>(CLI::App& group)`, listed in commands.cpp.
+// A sub-command's callback throws skybake::Error on bad input; main() turns it
+// into one line on stderr and exit code 1. CLI11 usage errors exit with 2.
+#pragma once
+
+#include <cstdio>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "skybake/core.h"
+#include "skybake/error.h"
+
+namespace skybake::cli {
+
+// Adds the --json flag every sub-command has.
+inline CLI::Option* add_json_flag(CLI::App& sub, bool& json) {
+    return sub.add_flag("--json", json, "Print a machine-readable JSON summary on stdout");
+}
+
+// Prints a JSON document on stdout (one object, pretty-printed).
+inline void print_json(const nlohmann::json& j) { std::fputs((j.dump(2) + "\n").c_str(), stdout); }
+
+// Informational line on stderr, unless --quiet.
+template <class... Args>
+void info(fmt::format_string<Args...> f, Args&&... args) {
+    if (!skybake::quiet())
+        fmt::print(stderr, "{}\n", fmt::format(f, std::forward<Args>(args)...));
+}
+
+// Parses "WxH" (e.g. "1280x720"); throws skybake::Error naming the flag.
+void parse_size(const std::string& text, int& width, int& height, const char* flag);
+
+} // namespace skybake::cli

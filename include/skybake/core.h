@@ -1,0 +1,28 @@
+// skybake/core.h: build facts, threading and logging controls.
+#pragma once
+
+#include <string>
+
+#include "skybake/version.h"
+
+namespace skybake {
+
+// "0.1.0"
+const char* version();
+// True when this build compiled the CUDA backends (a GPU may still be absent).
+bool build_has_cuda();
+// Number of CUDA devices usable now; 0 without CUDA or without a GPU.
+int cuda_device_count();
+// Name of CUDA device 0, or an empty string.
+std::string cuda_device_name();
+
+// Limits the worker threads used by parallel loops; 0 restores the default
+// (all hardware threads). Results do not depend on the thread count.
+void set_thread_count(int threads);
+int thread_count();
+
+// Quiet mode suppresses progress bars and informational messages on stderr.
+void set_quiet(bool quiet);
+bool quiet();
+
+} // namespace skybake

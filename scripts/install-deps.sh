@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages skybake builds, tests and runs with.
+# Only packages that are missing are installed. Safe to run repeatedly.
+#
+#   sudo scripts/install-deps.sh          # install what is missing
+#   scripts/install-deps.sh --check       # list what is missing, exit 1 if any
+set -euo pipefail
+
+PACKAGES=(
+  # toolchain
+  build-essential cmake ninja-build pkg-config git ca-certificates
+  clang libclang-rt-14-dev
+  # ray tracing and threading
+  libembree-dev libtbb-dev
+  # mesh and image I/O
+  libassimp-dev assimp-testmodels libtinygltf-dev libstb-dev libtinyexr-dev
+  # maths
+  libglm-dev libeigen3-dev
+  # CLI, formatting, JSON
+  libcli11-dev libfmt-dev nlohmann-json3-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev glslang-tools
+  # OpenGL (headless EGL and windowed GLFW)
+  libegl-dev libgl-dev libglfw3-dev libepoxy-dev libegl-mesa0
+  # Python bindings
+  pybind11-dev python3-dev
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+  [[ "$status" == "install ok installed" ]] || missing+=("$p")
+done
+
+if [[ ${#missing[@]} -eq 0 ]]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+if [[ "${1:-}" == "--check" ]]; then
+  echo "install-deps: missing: ${missing[*]}"
+  exit 1
+fi
+
+if [[ $(id -u) -ne 0 ]]; then
+  if command -v sudo >/dev/null 2>&1; then
+    echo "install-deps: not root; run: sudo apt-get install -y --no-install-recommends ${missing[*]}" >&2
+  else
+    echo "install-deps: not root; run as root: apt-get install -y --no-install-recommends ${missing[*]}" >&2
+  fi
+  exit 1
+fi
+
+echo "install-deps: installing ${#missing[@]} package(s): ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,91 @@
+#include "skybake/files.h"
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
+#include <fstream>
+#include <random>
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+#include "skybake/error.h"
+
+namespace skybake {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path temp_path_beside(const fs::path& target) {
+    static std::atomic<unsigned> counter{0};
+    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    return dir / fmt::format(".{}.tmp-{}-{}", target.filename().string(), ::getpid(), counter++);
+}
+
+void check_target(const fs::path& target) {
+    if (target.empty())
+        throw Error("output path is empty");
+    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec))
+        throw Error("output folder does not exist", dir.string());
+    if (fs::is_directory(target, ec))
+        throw Error("output path is a folder", target.string());
+}
+
+} // namespace
+
+void write_file_atomic(const fs::path& target, const std::function<void(const fs::path&)>& write) {
+    check_target(target);
+    const fs::path tmp = temp_path_beside(target);
+    std::error_code ec;
+    try {
+        write(tmp);
+    } catch (...) {
+        fs::remove(tmp, ec);
+        throw;
+    }
+    if (!fs::exists(tmp, ec))
+        throw Error("writer produced no file", target.string());
+    fs::rename(tmp, target, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw Error(fmt::format("cannot rename output into place: {}", ec.message()), target.string());
+    }
+}
+
+void write_stream_atomic(const fs::path& target, const std::function<void(std::ostream&)>& write) {
+    write_file_atomic(target, [&](const fs::path& tmp) {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        if (!out)
+            throw Error(fmt::format("cannot create file: {}", std::strerror(errno)), tmp.string());
+        write(out);
+        out.flush();
+        if (!out)
+            throw Error("write failed (disk full?)", target.string());
+    });
+}
+
+std::string read_file(const fs::path& path, std::uint64_t max_bytes) {
+    std::error_code ec;
+    if (!fs::exists(path, ec))
+        throw Error("file not found", path.string());
+    if (fs::is_directory(path, ec))
+        throw Error("path is a folder, not a file", path.string());
+    const auto size = fs::file_size(path, ec);
+    if (ec)
+        throw Error(fmt::format("cannot read file: {}", ec.message()), path.string());
+    if (size > max_bytes)
+        throw Error(fmt::format("file is {} bytes, over the limit of {} bytes", size, max_bytes), path.string());
+    std::ifstream in(path, std::ios::binary);
+    if (!in)
+        throw Error(fmt::format("cannot open file: {}", std::strerror(errno)), path.string());
+    std::string data(size, '\0');
+    in.read(data.data(), std::streamsize(size));
+    if (std::uint64_t(in.gcount()) != size)
+        throw Error("short read", path.string());
+    return data;
+}
+
+} // namespace skybake

@@ -1,0 +1,53 @@
+#include "core/progress.h"
+
+#include <cstdio>
+#include <unistd.h>
+
+#include "skybake/core.h"
+
+namespace skybake {
+
+Progress::Progress(std::string label, std::uint64_t total)
+    : label_(std::move(label)), total_(total), enabled_(!quiet() && isatty(STDERR_FILENO) == 1) {
+    start_ = last_draw_ = std::chrono::steady_clock::now();
+}
+
+Progress::~Progress() { finish(); }
+
+void Progress::advance(std::uint64_t n) {
+    const std::uint64_t done = done_.fetch_add(n) + n;
+    if (!enabled_)
+        return;
+    const auto now = std::chrono::steady_clock::now();
+    std::unique_lock lock(mutex_, std::try_to_lock);
+    if (!lock.owns_lock() || finished_ || now - last_draw_ < std::chrono::milliseconds(100))
+        return;
+    last_draw_ = now;
+    draw(done, false);
+}
+
+void Progress::finish() {
+    std::lock_guard lock(mutex_);
+    if (finished_)
+        return;
+    finished_ = true;
+    if (enabled_)
+        draw(done_.load(), true);
+}
+
+void Progress::draw(std::uint64_t done, bool final) {
+    const double frac = total_ ? double(done > total_ ? total_ : done) / double(total_) : 1.0;
+    const int width = 30;
+    const int filled = int(frac * width + 0.5);
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    char bar[width + 1];
+    for (int i = 0; i < width; ++i)
+        bar[i] = i < filled ? '#' : '.';
+    bar[width] = 0;
+    std::fprintf(stderr, "\r%s [%s] %5.1f%% %6.1fs", label_.c_str(), bar, frac * 100.0, secs);
+    if (final)
+        std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+}
+
+} // namespace skybake
