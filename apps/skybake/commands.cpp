@@ -1,29 +1,59 @@
 #include "commands.h"
 
-#include <initializer_list>
+#include <algorithm>
+#include <string>
+#include <vector>
 
 namespace skybake::cli {
 
-// One declaration per sub-command file.
-//void add_mesh_info(CLI::App& group);
-//void add_mesh_generate(CLI::App& group);
-//void add_mesh_convert(CLI::App& group);
-
 namespace {
 
-using AddFn = void (*)(CLI::App&);
+struct Entry {
+    std::string group, key;
+    AddCommandFn add;
+};
 
-void add_group(CLI::App& app, const char* name, const char* description, std::initializer_list<AddFn> subs) {
-    CLI::App* group = app.add_subcommand(name, description);
-    group->require_subcommand(1);
-    for (AddFn add : subs)
-        add(*group);
+std::vector<Entry>& registry() {
+    static std::vector<Entry> entries;
+    return entries;
 }
+
+struct Group {
+    const char* name;
+    const char* description;
+};
+
+// Every group the tool knows, in --help order.
+const Group kGroups[] = {
+    {"mesh", "Inspect, convert and generate meshes"},
+    {"sky", "Atmospheric scattering: reference model, neural sky, rendering and shader export"},
+    {"sphere", "Quadrature rules on the sphere and spherical harmonics"},
+    {"ao", "Bake per-vertex ambient occlusion and shading coefficients"},
+    {"prt", "Bake spherical-harmonic transfer (PRT/DPRT)"},
+};
 
 } // namespace
 
+CommandRegistration::CommandRegistration(const char* group, const char* key, AddCommandFn add) {
+    registry().push_back({group, key, add});
+}
+
 void add_all_commands(CLI::App& app) {
-    // groups are added here
+    auto entries = registry();
+    std::sort(entries.begin(), entries.end(),
+              [](const Entry& a, const Entry& b) { return a.group != b.group ? a.group < b.group : a.key < b.key; });
+    for (const Group& g : kGroups) {
+        CLI::App* group = nullptr;
+        for (const Entry& e : entries) {
+            if (e.group != g.name)
+                continue;
+            if (!group) {
+                group = app.add_subcommand(g.name, g.description);
+                group->require_subcommand(1);
+            }
+            e.add(*group);
+        }
+    }
 }
 
 } // namespace skybake::cli

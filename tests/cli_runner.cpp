@@ -1,0 +1,71 @@
+#include "cli_runner.h"
+
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace skybake::test {
+
+int CliResult::err_lines() const {
+    int n = 0;
+    for (char c : err)
+        n += c == '\n';
+    if (!err.empty() && err.back() != '\n')
+        ++n;
+    return n;
+}
+
+std::string temp_dir(const std::string& name) {
+    namespace fs = std::filesystem;
+    fs::path p = fs::temp_directory_path() / ("skybake-test-" + std::to_string(::getpid())) / name;
+    fs::remove_all(p);
+    fs::create_directories(p);
+    return p.string();
+}
+
+CliResult run_cli(const std::vector<std::string>& args, int timeout_s) {
+    namespace fs = std::filesystem;
+    static int counter = 0;
+    const fs::path dir = temp_dir("cli-capture");
+    const fs::path out_path = dir / ("out" + std::to_string(counter));
+    const fs::path err_path = dir / ("err" + std::to_string(counter++));
+    CliResult r;
+    pid_t pid = fork();
+    if (pid == 0) {
+        FILE* o = std::freopen(out_path.c_str(), "w", stdout);
+        FILE* e = std::freopen(err_path.c_str(), "w", stderr);
+        if (!o || !e)
+            _exit(127);
+        alarm(unsigned(timeout_s)); // SIGALRM kills a hang
+        std::vector<char*> argv;
+        std::string prog = SKYBAKE_CLI_PATH;
+        argv.push_back(prog.data());
+        std::vector<std::string> copy = args;
+        for (auto& a : copy)
+            argv.push_back(a.data());
+        argv.push_back(nullptr);
+        execv(prog.c_str(), argv.data());
+        _exit(127);
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    if (WIFEXITED(status))
+        r.exit_code = WEXITSTATUS(status);
+    else if (WIFSIGNALED(status))
+        r.signal = WTERMSIG(status);
+    auto slurp = [](const fs::path& p) {
+        std::ifstream in(p, std::ios::binary);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        return ss.str();
+    };
+    r.out = slurp(out_path);
+    r.err = slurp(err_path);
+    return r;
+}
+
+} // namespace skybake::test

@@ -1,0 +1,24 @@
+// Runs the skybake CLI as a subprocess and captures its exit code, stdout and
+// stderr. For end-to-end tests.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace skybake::test {
+
+struct CliResult {
+    int exit_code = -1; // -1: killed by a signal (a crash) or by the timeout
+    int signal = 0;
+    std::string out, err;
+    // Number of lines in err (a trailing newline does not start a new line).
+    int err_lines() const;
+};
+
+// args do not include the program name. timeout_s kills a hung process.
+CliResult run_cli(const std::vector<std::string>& args, int timeout_s = 120);
+
+// A fresh empty folder under the build tree's temp area, removed by the OS later.
+std::string temp_dir(const std::string& name);
+
+} // namespace skybake::test
