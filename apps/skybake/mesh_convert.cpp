@@ -1,0 +1,45 @@
+// skybake mesh convert INPUT -o OUTPUT.glb|.ply [--ascii] [--json]
+#include "cli.h"
+#include "commands.h"
+#include "skybake/mesh.h"
+
+namespace skybake::cli {
+
+namespace {
+struct MeshConvertOptions {
+    std::string input, output;
+    bool ascii = false;
+    bool json = false;
+};
+
+void run(const MeshConvertOptions& o) {
+    ImportReport rep;
+    const Mesh mesh = load_mesh(o.input, &rep);
+    ExportOptions e;
+    e.ply_encoding = o.ascii ? PlyEncoding::Ascii : PlyEncoding::Binary;
+    save_mesh(o.output, mesh, e);
+    if (o.json) {
+        print_json({{"input", o.input},
+                    {"output", o.output},
+                    {"vertices", mesh.vertex_count()},
+                    {"triangles", mesh.triangle_count()},
+                    {"degenerate_triangles", rep.degenerate_triangles}});
+        return;
+    }
+    info("wrote {} ({} vertices, {} triangles)", o.output, mesh.vertex_count(), mesh.triangle_count());
+}
+} // namespace
+
+void add_mesh_convert(CLI::App& group) {
+    auto o = std::make_shared<MeshConvertOptions>();
+    CLI::App* sub = group.add_subcommand("convert", "Read any supported mesh and write it as .glb or .ply");
+    sub->add_option("input", o->input, "Input mesh")->required();
+    sub->add_option("-o,--output", o->output, "Output mesh (.glb or .ply)")->required();
+    sub->add_flag("--ascii", o->ascii, "Write PLY as ASCII instead of binary");
+    add_json_flag(*sub, o->json);
+    sub->callback([o] { run(*o); });
+}
+
+SKYBAKE_CLI_COMMAND("mesh", add_mesh_convert)
+
+} // namespace skybake::cli

@@ -1,0 +1,303 @@
+// skybake/sky.h: single-scattering sky model (Nishita et al. 1993) with the
+// optical-length tables and the marching sum of Pietras & Rudnicki (seed 000),
+// and an exact double-precision reference.
+//
+// [SECTION] Units and frames
+// [SECTION] Atmosphere description
+// [SECTION] Presets and JSON files
+// [SECTION] Phase functions and density profiles
+// [SECTION] Input space of the sky function
+// [SECTION] Optical-length tables
+// [SECTION] Sky colour
+// [SECTION] Surface colour
+// [SECTION] Rendering
+//
+// See docs/sky.md for the maths, the measured errors and examples.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "skybake/image.h"
+
+namespace skybake {
+
+// [SECTION] Units and frames ---------------------------------------------------
+//
+// Lengths are in kilometres for every preset ("_km"); scattering and extinction
+// coefficients are per kilometre ("_per_km"). Optical lengths t = ∫ρ ds are in
+// kilometres (relative density times length). Colours are RGB triples; for the
+// presets the channels are R, G, B in that order.
+//
+// Radiance is per unit sun irradiance at the top of the atmosphere, in 1/sr:
+// multiply by the sun irradiance to get radiance in the irradiance's unit per sr.
+//
+// Angles of the sky function, all cosines (seed 000 notation):
+//   cos α: view direction V against the local vertical U ("cos_view_zenith"),
+//   cos β: view direction V against the sun direction L ("cos_view_sun"),
+//   cos θ: local vertical U against the sun direction L ("cos_sun_zenith").
+// V points from the observer into the sky, L points from the scene to the sun.
+
+// [SECTION] Atmosphere description --------------------------------------------
+
+enum class PhaseFunction : int {
+    None = 0,              // absorbs only (e.g. ozone); scattering must be 0
+    Rayleigh = 1,          // 3/(16π) (1 + cos²)
+    HenyeyGreenstein = 2,  // (1 − g²) / (4π (1 + g² − 2g cos)^1.5)
+    CornetteShanks = 3,    // 3(1 − g²)(1 + cos²) / (8π (2 + g²)(1 + g² − 2g cos)^1.5)
+    SeedMie = 4,           // as printed in seed 000: (1 − g²) / (16π (1 + g² − 2g cos)^1.5);
+                           // this is Henyey–Greenstein / 4 and integrates to 1/4, not 1
+};
+
+enum class DensityProfile : int {
+    Exponential = 0, // ρ = exp(−h / scale_height_km)
+    Tent = 1,        // ρ = max(0, 1 − |h − tent_center_km| / tent_half_width_km) (ozone-like)
+    Constant = 2,    // ρ = 1 everywhere below the top (a uniform shell; for tests)
+};
+
+struct AtmosphereComponent {
+    std::string name;                      // "rayleigh", "mie", "ozone", ...
+    DensityProfile profile = DensityProfile::Exponential;
+    double scale_height_km = 8.0;          // Exponential only; > 0
+    double tent_center_km = 25.0;          // Tent only: altitude of the peak
+    double tent_half_width_km = 15.0;      // Tent only; > 0
+    glm::dvec3 scattering_per_km{0.0};     // at relative density 1, per channel, ≥ 0
+    glm::dvec3 extinction_per_km{0.0};     // at relative density 1, per channel, ≥ scattering
+    PhaseFunction phase = PhaseFunction::Rayleigh;
+    double phase_g = 0.0;                  // asymmetry parameter in (−1, 1) for HG, CS and SeedMie
+};
+
+// How each shell of the optical-length table weighs its length (see docs/sky.md).
+enum class TableRule : int {
+    Seed = 0,    // seed 000 as printed: S = ρ_i s_i, the density at the shell's outer boundary
+    LogMean = 1, // the mean density over the shell's height; exact for vertical rays
+};
+
+struct Atmosphere {
+    std::string name;
+    double planet_radius_km = 6360.0; // R0, the ground
+    double top_radius_km = 6420.0;    // the top of the atmosphere; > planet_radius_km
+    // Any number (1 to 4) of components. The first must be Exponential: its
+    // relative density ρ0 is the observer coordinate of the sky function.
+    std::vector<AtmosphereComponent> components;
+    // Sun: direction for rendering, irradiance at the top of the atmosphere
+    // (radiances are per unit irradiance; the renderer multiplies by this).
+    double sun_elevation_deg = 30.0; // above the observer's horizon
+    double sun_azimuth_deg = 0.0;    // clockwise from the observer's +x ("north")
+    glm::dvec3 sun_irradiance{1.0};
+    double sun_angular_radius_rad = 0.004675;
+    glm::dvec3 ground_albedo{0.1};   // Lambertian ground reflectance C, per channel, in [0, 1]
+    TableRule table_rule = TableRule::Seed;
+
+    // Throws skybake::Error naming the first bad field.
+    void validate() const;
+    // Altitude (km above the ground) where the first component has relative density rho in (0, 1].
+    double altitude_from_density(double rho) const;
+    // Relative density of the first component at altitude_km.
+    double density_from_altitude(double altitude_km) const;
+};
+
+// [SECTION] Presets and JSON files ----------------------------------------------
+//
+// "earth"       physical Earth (Bruneton 2017 / Hillaire 2020 values, km units),
+//               Rayleigh + Mie (Cornette–Shanks, g = 0.8) + ozone (tent 10–40 km).
+// "paper"       seed 000 section VII with r = m = 10000 (override with r, m).
+// "paper-dense" seed 000 section VII with r = m = 100.
+// The seed gives no planet radius: the paper presets use R0 = 6371 km (Earth's
+// mean radius), since its scale heights 8.3 and 1.6 are Earth's, in km; the top
+// is at 100 km, where the gas density is 6e-6. Mie g = 0.76 (the seed gives none).
+std::vector<std::string> atmosphere_preset_names();
+// Throws skybake::Error for an unknown name. r and m apply to "paper" only
+// (the seed's divisors of the Rayleigh and Mie coefficients; > 0).
+Atmosphere atmosphere_preset(std::string_view name, double paper_r = 10000.0, double paper_m = 10000.0);
+
+// JSON text <-> Atmosphere. Parsing throws skybake::Error naming `where` and the field.
+std::string atmosphere_to_json(const Atmosphere& atmosphere);
+Atmosphere atmosphere_from_json(std::string_view text, const std::string& where = "atmosphere JSON");
+Atmosphere load_atmosphere(const std::filesystem::path& path);
+void save_atmosphere(const std::filesystem::path& path, const Atmosphere& atmosphere);
+
+// [SECTION] Phase functions and density profiles ---------------------------------
+// cos_theta: cosine of the angle between the view direction and the sun
+// direction (1: looking at the sun). Result in 1/sr.
+double phase_function(PhaseFunction phase, double g, double cos_theta);
+// Relative density of one component at altitude_km above the ground (≥ 0).
+double relative_density(const AtmosphereComponent& component, double altitude_km);
+
+// [SECTION] Input space of the sky function --------------------------------------
+//
+// The sky function I(cos α0, cos β0, cos θ0, ρ0) is defined on
+// [−1, 1]³ × (0, 1]. Three cosines describe three real unit vectors (V, L, U)
+// only when their Gram determinant is non-negative:
+//     1 + 2abc − a² − b² − c² ≥ 0.
+struct SkySample {
+    float cos_view_zenith = 1.0f; // cos α0 = V·U at the observer
+    float cos_view_sun = 1.0f;    // cos β0 = V·L
+    float cos_sun_zenith = 1.0f;  // cos θ0 = U·L at the observer
+    float density = 1.0f;         // ρ0: relative density of the first component at the observer, in (0, 1]
+};
+
+// 1 + 2abc − a² − b² − c² (the Gram determinant of three unit vectors).
+double cosine_triple_determinant(double a, double b, double c);
+// Determinant ≥ −tolerance and each cosine in [−1, 1].
+bool is_valid_cosine_triple(double a, double b, double c, double tolerance = 1e-6);
+// Valid triple and density in (0, 1] (all finite).
+bool is_valid_sky_sample(const SkySample& sample, double tolerance = 1e-6);
+// Throws skybake::Error saying what is wrong, naming `where`.
+void check_sky_sample(const SkySample& sample, const std::string& where);
+// `count` valid samples drawn uniformly from [−1,1]³ × (0,1] with rejection of
+// invalid triples; deterministic in seed, independent of the thread count.
+std::vector<SkySample> draw_sky_samples(std::size_t count, std::uint64_t seed);
+
+// [SECTION] Optical-length tables -------------------------------------------------
+//
+// Seed 000 section I. For each component k two tables over (u, c):
+//   S[u, c]: one shell's contribution ρ_i s_i,
+//   L[u, c]: the optical length from a point to the top, Σ S along the ray.
+// u is the table's height coordinate: for Exponential components the relative
+// density ρ, sampled uniformly ρ_i = i/n as in the seed; for Tent and Constant
+// components the altitude over the atmosphere's height, uniformly. c = cos α is
+// sampled uniformly on [0, 1]; downward rays use the seed's symmetry
+// L[ρ, −c] = 2 L[ρ_x, 0] − L[ρ, c], with ρ_x the density at the tangent point.
+struct TableResolution {
+    int shells = 256;  // n: rows are u_i = i/n, i = 0..n; ≥ 2
+    int cosines = 128; // m: columns are c_j = j/m, j = 0..m; ≥ 2
+};
+
+class OpticalLengthTables {
+public:
+    OpticalLengthTables() = default;
+    // Builds the S and L tables of every component (in double, stored as float).
+    static OpticalLengthTables build(const Atmosphere& atmosphere, const TableResolution& resolution = {});
+
+    // Bilinear lookup of t = ∫ρ_k ds from altitude_km towards the direction with
+    // cos_zenith (−1..1) to the top, in km. Downward rays that hit the ground use
+    // the seed's clamp ρ_x = 1 (their differences along one ray stay exact).
+    double optical_length(int component, double altitude_km, double cos_zenith) const;
+
+    int components() const { return int(length_.size()); }
+    int rows() const { return resolution_.shells + 1; }
+    int columns() const { return resolution_.cosines + 1; }
+    const TableResolution& resolution() const { return resolution_; }
+    // Row-major, rows() x columns() floats: [row * columns() + column].
+    const std::vector<float>& length_table(int component) const { return length_[std::size_t(component)]; }
+    const std::vector<float>& shell_table(int component) const { return shell_[std::size_t(component)]; }
+    const Atmosphere& atmosphere() const { return atmosphere_; }
+
+private:
+    Atmosphere atmosphere_;
+    TableResolution resolution_;
+    std::vector<std::vector<float>> length_, shell_;
+};
+
+// Exact optical length ∫ρ_k ds from altitude_km in the direction cos_zenith to
+// the top of the atmosphere, by adaptive Gauss–Kronrod quadrature in double
+// precision along the true ray. +infinity when the ray hits the ground.
+double optical_length_exact(const Atmosphere& atmosphere, int component, double altitude_km, double cos_zenith);
+
+// [SECTION] Sky colour -------------------------------------------------------------
+enum class SkyMethod : int {
+    Tables = 0, // the seed's marching sum over the optical-length tables (float)
+    Exact = 1,  // adaptive quadrature along the true geometry (double)
+};
+
+struct SkyModelOptions {
+    TableResolution tables{};
+    // Steps of the seed's sum along the view ray (midpoint rule, uniform Δv).
+    // 16 meets 2,000,000 samples/s on two cores; see docs/PERFORMANCE.md.
+    int steps = 16;
+    // Relative tolerance of the exact quadrature.
+    double exact_tolerance = 1e-7;
+};
+
+// Single-scattered radiance I per unit sun irradiance, in 1/sr, looking from
+// the observer along V until the ray leaves the atmosphere or meets the
+// ground; samples in the planet's shadow add nothing. Observers above the top
+// of the atmosphere (tiny ρ0) see the atmosphere from outside.
+class SkyModel {
+public:
+    explicit SkyModel(Atmosphere atmosphere, const SkyModelOptions& options = {});
+    ~SkyModel();
+    SkyModel(SkyModel&&) noexcept;
+    SkyModel& operator=(SkyModel&&) noexcept;
+
+    const Atmosphere& atmosphere() const;
+    const OpticalLengthTables& tables() const;
+    const SkyModelOptions& options() const;
+
+    // One sample; the sample must be valid (asserted).
+    glm::dvec3 radiance(const SkySample& sample, SkyMethod method) const;
+    // Same, from an observer at radius_km from the planet centre (may be above the top).
+    glm::dvec3 radiance_at_radius(double radius_km, double cos_view_zenith, double cos_view_sun,
+                                  double cos_sun_zenith, SkyMethod method) const;
+    // Seed's sum with an explicit step count (for convergence studies).
+    glm::dvec3 radiance_tables(const SkySample& sample, int steps) const;
+
+    // Opaque view of the flat data for the shared CPU/GPU code in src/sky/.
+    const void* device_view() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+// Batch evaluation over all cores. out.size() must equal samples.size(); every
+// sample must be valid (check with is_valid_sky_sample first; asserted).
+// Deterministic, independent of the thread count.
+void evaluate_sky(const SkyModel& model, std::span<const SkySample> samples, std::span<glm::vec3> out,
+                  SkyMethod method);
+// Convenience: builds a SkyModel with default options first.
+void evaluate_sky(const Atmosphere& atmosphere, std::span<const SkySample> samples, std::span<glm::vec3> out,
+                  SkyMethod method);
+
+// [SECTION] Surface colour ------------------------------------------------------------
+//
+// Seed 000 section IV. Positions are in km in a planet-centred frame; the sun
+// direction is a unit vector in the same frame.
+struct SurfaceLight {
+    // Light scattered into the view between observer and surface point, 1/sr:
+    glm::dvec3 inscatter_seed{0.0};  // the seed's difference I(observer) − I(probe at the surface), tables
+    glm::dvec3 inscatter_exact{0.0}; // exact quadrature over the segment
+    // Sunlight reflected by the Lambertian surface and attenuated to the observer, 1/sr:
+    glm::dvec3 reflected_tables{0.0};
+    glm::dvec3 reflected_exact{0.0};
+    glm::dvec3 transmittance_exact{1.0}; // observer <- surface point
+};
+
+// surface_km: a point on or above the ground; its normal is radial. albedo C per channel.
+SurfaceLight surface_light(const SkyModel& model, const glm::dvec3& observer_km, const glm::dvec3& surface_km,
+                           const glm::dvec3& sun_direction, const glm::dvec3& albedo);
+
+// [SECTION] Rendering ---------------------------------------------------------------------
+enum class SkyView : int {
+    Fisheye = 0,  // upward hemisphere, equidistant; zenith at the centre, azimuth 0 up, 90° right
+    Panorama = 1, // equirectangular: azimuth 0..360° left to right, elevation +90° (top) to −90°
+    Camera = 2,   // pinhole: horizontal field of view fov_deg, looking along yaw_deg / pitch_deg
+};
+
+struct SkyRenderSettings {
+    double altitude_km = 0.0;       // observer above the ground, ≥ 0 (may be far outside the atmosphere)
+    double sun_elevation_deg = 30.0;
+    double sun_azimuth_deg = 0.0;
+    SkyView view = SkyView::Fisheye;
+    double fov_deg = 90.0;          // Camera only, horizontal, in (0, 180)
+    double yaw_deg = 0.0;           // Camera: azimuth of the view centre
+    double pitch_deg = 0.0;         // Camera: elevation of the view centre
+    int width = 512, height = 512;
+    SkyMethod method = SkyMethod::Tables;
+    bool sun_disc = true;           // add the attenuated sun disc
+};
+
+// Linear radiance per pixel (times the atmosphere's sun irradiance): the sky,
+// the lit and unlit ground (Lambert, the atmosphere's ground albedo) and the
+// planet seen from space. Uses all cores.
+Image render_sky(const SkyModel& model, const SkyRenderSettings& settings);
+
+} // namespace skybake

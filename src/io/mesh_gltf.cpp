@@ -1,0 +1,512 @@
+// glTF 2.0 import and export through tinygltf.
+// Khronos Group, "glTF 2.0 Specification", 2017-2021.
+//
+// glTF goes through tinygltf rather than Assimp because Assimp drops
+// application-specific vertex attributes ("_AO"), which skybake writes and
+// must read back bit-exactly. Every accessor is bounds-checked here before it
+// is read; tinygltf's own checks are not relied upon.
+#include <cmath>
+#include <cstring>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <glm/gtc/matrix_inverse.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <glm/mat4x4.hpp>
+// tinygltf is compiled here from Debian's header rather than linked from its
+// libtinygltf.so: that library was built from a header revision whose class
+// layout differs from the installed tiny_gltf.h (TinyGLTF::SetFsCallbacks
+// writes past the members this header declares). Images are never decoded,
+// so stb is left out.
+#define TINYGLTF_IMPLEMENTATION
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_EXTERNAL_IMAGE
+#include <tiny_gltf.h>
+
+#include "io/mesh_internal.h"
+#include "skybake/error.h"
+
+namespace skybake::io {
+
+namespace {
+
+constexpr unsigned kMaxNodeDepth = 256;
+
+struct FsContext {
+    std::string base_dir; // empty: no external files (loading from memory)
+    std::uint64_t max_bytes;
+};
+
+bool fs_exists(const std::string& path, void* user) {
+    auto* ctx = static_cast<FsContext*>(user);
+    if (ctx->base_dir.empty())
+        return false;
+    std::error_code ec;
+    return std::filesystem::is_regular_file(path, ec);
+}
+
+std::string fs_expand(const std::string& path, void*) { return path; } // no shell expansion
+
+bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& path, void* user) {
+    auto* ctx = static_cast<FsContext*>(user);
+    namespace fs = std::filesystem;
+    if (ctx->base_dir.empty()) {
+        *err = "external file '" + path + "' cannot be resolved when loading from memory";
+        return false;
+    }
+    std::error_code ec;
+    const auto size = fs::file_size(path, ec);
+    if (ec || size > ctx->max_bytes) {
+        *err = ec ? "cannot read '" + path + "'" : "'" + path + "' is over the size limit";
+        return false;
+    }
+    std::ifstream in(path, std::ios::binary);
+    out->resize(size);
+    in.read(reinterpret_cast<char*>(out->data()), std::streamsize(size));
+    if (!in) {
+        *err = "cannot read '" + path + "'";
+        return false;
+    }
+    return true;
+}
+
+bool fs_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+    *err = "writing is not supported here";
+    return false;
+}
+
+// Images are not needed for lighting; skip decoding them.
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+    return true;
+}
+
+struct AccessorView {
+    const unsigned char* data = nullptr;
+    std::size_t count = 0, stride = 0;
+    int component_type = 0, components = 0;
+    bool normalized = false;
+};
+
+int components_of(int type) {
+    switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+    default: return 0;
+    }
+}
+
+std::size_t component_bytes(int ct) {
+    switch (ct) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0;
+    }
+}
+
+class Reader {
+public:
+    Reader(const tinygltf::Model& model, const std::string& where, const ImportLimits& limits)
+        : model_(model), where_(where), limits_(limits) {}
+
+    AccessorView view(int index, const char* what) const {
+        if (index < 0 || std::size_t(index) >= model_.accessors.size())
+            fail(fmt::format("{} refers to accessor {}, but there are {}", what, index, model_.accessors.size()));
+        const tinygltf::Accessor& a = model_.accessors[std::size_t(index)];
+        if (a.sparse.isSparse)
+            fail(fmt::format("accessor {} ({}) is sparse; sparse accessors are not supported", index, what));
+        AccessorView v;
+        v.count = a.count;
+        v.component_type = a.componentType;
+        v.components = components_of(a.type);
+        v.normalized = a.normalized;
+        const std::size_t cb = component_bytes(a.componentType);
+        if (v.components == 0 || cb == 0)
+            fail(fmt::format("accessor {} ({}) has an unsupported type", index, what));
+        const std::size_t elem = cb * std::size_t(v.components);
+        if (a.bufferView < 0 || std::size_t(a.bufferView) >= model_.bufferViews.size())
+            fail(fmt::format("accessor {} ({}) has no valid bufferView", index, what));
+        const tinygltf::BufferView& bv = model_.bufferViews[std::size_t(a.bufferView)];
+        if (bv.buffer < 0 || std::size_t(bv.buffer) >= model_.buffers.size())
+            fail(fmt::format("bufferView {} refers to missing buffer {}", a.bufferView, bv.buffer));
+        const tinygltf::Buffer& buf = model_.buffers[std::size_t(bv.buffer)];
+        v.stride = bv.byteStride ? bv.byteStride : elem;
+        if (v.stride < elem)
+            fail(fmt::format("bufferView {} has byteStride {} smaller than its element ({} bytes)", a.bufferView,
+                             v.stride, elem));
+        // Overflow-safe: every quantity is checked against the buffer size first.
+        const std::uint64_t buf_size = buf.data.size();
+        if (bv.byteOffset > buf_size || bv.byteLength > buf_size - bv.byteOffset)
+            fail(fmt::format("bufferView {} (offset {}, length {}) runs past its buffer of {} bytes", a.bufferView,
+                             bv.byteOffset, bv.byteLength, buf_size));
+        if (v.count == 0)
+            return v;
+        if (v.count > (std::uint64_t(1) << 40) / v.stride)
+            fail(fmt::format("accessor {} ({}) declares an absurd count {}", index, what, v.count));
+        const std::uint64_t need = std::uint64_t(a.byteOffset) + (v.count - 1) * v.stride + elem;
+        if (a.byteOffset > bv.byteLength || need > bv.byteLength)
+            fail(fmt::format("accessor {} ({}) needs {} bytes but its bufferView has {}", index, what, need,
+                             bv.byteLength));
+        v.data = buf.data.data() + bv.byteOffset + a.byteOffset;
+        return v;
+    }
+
+    // Reads component c of element i as float, normalising integers when asked.
+    static float read(const AccessorView& v, std::size_t i, int c) {
+        const unsigned char* p = v.data + i * v.stride + std::size_t(c) * component_bytes(v.component_type);
+        switch (v.component_type) {
+        case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+            float f;
+            std::memcpy(&f, p, 4);
+            return f;
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return v.normalized ? float(*p) / 255.0f : float(*p);
+        case TINYGLTF_COMPONENT_TYPE_BYTE: {
+            const float f = float(std::int8_t(*p));
+            return v.normalized ? std::max(f / 127.0f, -1.0f) : f;
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+            std::uint16_t u;
+            std::memcpy(&u, p, 2);
+            return v.normalized ? float(u) / 65535.0f : float(u);
+        }
+        case TINYGLTF_COMPONENT_TYPE_SHORT: {
+            std::int16_t s;
+            std::memcpy(&s, p, 2);
+            return v.normalized ? std::max(float(s) / 32767.0f, -1.0f) : float(s);
+        }
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+            std::uint32_t u;
+            std::memcpy(&u, p, 4);
+            return float(u);
+        }
+        }
+        return 0.0f;
+    }
+
+    static std::uint32_t read_index(const AccessorView& v, std::size_t i) {
+        const unsigned char* p = v.data + i * v.stride;
+        switch (v.component_type) {
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return *p;
+        case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+            std::uint16_t u;
+            std::memcpy(&u, p, 2);
+            return u;
+        }
+        default: {
+            std::uint32_t u;
+            std::memcpy(&u, p, 4);
+            return u;
+        }
+        }
+    }
+
+    [[noreturn]] void fail(const std::string& msg) const { throw Error(msg, where_); }
+
+    void visit(int node_index, const glm::dmat4& parent, unsigned depth) {
+        if (depth > kMaxNodeDepth)
+            fail(fmt::format("node hierarchy deeper than {} levels (a cycle?)", kMaxNodeDepth));
+        if (node_index < 0 || std::size_t(node_index) >= model_.nodes.size())
+            fail(fmt::format("reference to node {}, but there are {}", node_index, model_.nodes.size()));
+        const tinygltf::Node& node = model_.nodes[std::size_t(node_index)];
+        glm::dmat4 local(1.0);
+        if (node.matrix.size() == 16) {
+            local = glm::make_mat4(node.matrix.data()); // column-major, as glTF
+        } else {
+            glm::dmat4 t(1.0), r(1.0), s(1.0);
+            if (node.translation.size() == 3)
+                t = glm::translate(glm::dmat4(1.0), glm::make_vec3(node.translation.data()));
+            if (node.rotation.size() == 4)
+                r = glm::mat4_cast(glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
+            if (node.scale.size() == 3)
+                s = glm::scale(glm::dmat4(1.0), glm::make_vec3(node.scale.data()));
+            local = t * r * s;
+        }
+        const glm::dmat4 world = parent * local;
+        if (node.mesh >= 0) {
+            if (std::size_t(node.mesh) >= model_.meshes.size())
+                fail(fmt::format("node {} refers to mesh {}, but there are {}", node_index, node.mesh,
+                                 model_.meshes.size()));
+            append_mesh(model_.meshes[std::size_t(node.mesh)], world);
+        }
+        for (int child : node.children)
+            visit(child, world, depth + 1);
+    }
+
+    void append_mesh(const tinygltf::Mesh& m, const glm::dmat4& world) {
+        const glm::dmat3 normal_matrix = glm::inverseTranspose(glm::dmat3(world));
+        for (const tinygltf::Primitive& prim : m.primitives) {
+            if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1) {
+                ++out.report.non_triangles;
+                continue;
+            }
+            auto pos_it = prim.attributes.find("POSITION");
+            if (pos_it == prim.attributes.end())
+                fail("a triangle primitive has no POSITION attribute");
+            const AccessorView pos = view(pos_it->second, "POSITION");
+            if (pos.components != 3 || pos.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT)
+                fail("POSITION must be a float VEC3 accessor");
+            Mesh& mesh = out.mesh;
+            const std::size_t base = mesh.positions.size();
+            check_counts(base + pos.count, mesh.triangle_count(), limits_, where_);
+            ++out.report.source_meshes;
+
+            for (std::size_t i = 0; i < pos.count; ++i) {
+                const glm::dvec4 p = world * glm::dvec4(read(pos, i, 0), read(pos, i, 1), read(pos, i, 2), 1.0);
+                mesh.positions.emplace_back(p);
+            }
+            // Normals
+            auto n_it = prim.attributes.find("NORMAL");
+            if (n_it != prim.attributes.end()) {
+                const AccessorView n = view(n_it->second, "NORMAL");
+                if (n.count != pos.count || n.components != 3)
+                    fail("NORMAL must be a VEC3 accessor with one entry per vertex");
+                for (std::size_t i = 0; i < n.count; ++i)
+                    mesh.normals.emplace_back(normal_matrix * glm::dvec3(read(n, i, 0), read(n, i, 1), read(n, i, 2)));
+            } else {
+                missing_normals = true;
+                mesh.normals.resize(mesh.positions.size(), glm::vec3(0.0f));
+            }
+            // Colours
+            auto c_it = prim.attributes.find("COLOR_0");
+            if (c_it != prim.attributes.end()) {
+                const AccessorView c = view(c_it->second, "COLOR_0");
+                if (c.count != pos.count || (c.components != 3 && c.components != 4))
+                    fail("COLOR_0 must be a VEC3 or VEC4 accessor with one entry per vertex");
+                mesh.colors.resize(base, glm::vec4(1.0f));
+                for (std::size_t i = 0; i < c.count; ++i)
+                    mesh.colors.emplace_back(read(c, i, 0), read(c, i, 1), read(c, i, 2),
+                                             c.components == 4 ? read(c, i, 3) : 1.0f);
+                any_colors = true;
+            } else {
+                mesh.colors.resize(mesh.positions.size(), glm::vec4(1.0f));
+            }
+            // Application-specific attributes: "_AO" -> "ao"
+            for (const auto& [semantic, acc] : prim.attributes) {
+                if (semantic.size() < 2 || semantic[0] != '_')
+                    continue;
+                std::string name;
+                for (char ch : semantic.substr(1))
+                    name += char(std::tolower(static_cast<unsigned char>(ch)));
+                if (!is_valid_attribute_name(name))
+                    continue;
+                const AccessorView a = view(acc, semantic.c_str());
+                if (a.count != pos.count)
+                    fail(fmt::format("attribute {} has {} entries for {} vertices", semantic, a.count, pos.count));
+                VertexAttribute* dst = nullptr;
+                for (auto& existing : mesh.attributes)
+                    if (existing.name == name)
+                        dst = &existing;
+                if (!dst) {
+                    mesh.attributes.push_back({name, a.components, {}});
+                    dst = &mesh.attributes.back();
+                }
+                if (dst->components != a.components)
+                    fail(fmt::format("attribute {} changes component count between primitives", semantic));
+                dst->values.resize(base * std::size_t(a.components), 0.0f);
+                for (std::size_t i = 0; i < a.count; ++i)
+                    for (int k = 0; k < a.components; ++k)
+                        dst->values.push_back(read(a, i, k));
+            }
+            for (auto& attr : mesh.attributes)
+                attr.values.resize(mesh.positions.size() * std::size_t(attr.components), 0.0f);
+            // Indices
+            if (prim.indices >= 0) {
+                const AccessorView idx = view(prim.indices, "indices");
+                if (idx.components != 1 || (idx.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                                             idx.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                                             idx.component_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT))
+                    fail("indices must be an unsigned integer SCALAR accessor");
+                if (idx.count % 3 != 0)
+                    fail(fmt::format("triangle primitive has {} indices, not a multiple of 3", idx.count));
+                for (std::size_t i = 0; i < idx.count; ++i) {
+                    const std::uint32_t k = read_index(idx, i);
+                    if (k >= pos.count)
+                        fail(fmt::format("index {} is {}, but the primitive has {} vertices", i, k, pos.count));
+                    mesh.indices.push_back(std::uint32_t(base + k));
+                }
+                check_counts(mesh.positions.size(), mesh.triangle_count(), limits_, where_);
+            } else {
+                if (pos.count % 3 != 0)
+                    fail(fmt::format("non-indexed triangle primitive has {} vertices, not a multiple of 3", pos.count));
+                for (std::size_t i = 0; i < pos.count; ++i)
+                    mesh.indices.push_back(std::uint32_t(base + i));
+            }
+        }
+    }
+
+    RawImport out;
+    bool missing_normals = false;
+    bool any_colors = false;
+
+private:
+    const tinygltf::Model& model_;
+    const std::string& where_;
+    const ImportLimits& limits_;
+};
+
+} // namespace
+
+RawImport read_gltf(const void* data, std::size_t size, bool binary, const std::string& base_dir,
+                    const std::string& where, const ImportLimits& limits) {
+    tinygltf::TinyGLTF loader;
+    FsContext fs_ctx{base_dir, limits.max_file_bytes};
+    loader.SetFsCallbacks({fs_exists, fs_expand, fs_read, fs_write, &fs_ctx});
+    loader.SetImageLoader(skip_image, nullptr);
+    tinygltf::Model model;
+    std::string err, warn;
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    bool ok = false;
+    try {
+        ok = binary ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes, unsigned(size), base_dir)
+                    : loader.LoadASCIIFromString(&model, &err, &warn, static_cast<const char*>(data), unsigned(size),
+                                                 base_dir);
+    } catch (const std::bad_alloc&) {
+        throw;
+    } catch (const std::exception& e) { // JSON type errors in malformed files
+        throw Error(fmt::format("malformed glTF: {}", e.what()), where);
+    }
+    if (!ok) {
+        std::string first = err.substr(0, err.find('\n'));
+        if (first.empty())
+            first = "unknown reason";
+        throw Error(fmt::format("cannot read glTF: {}", first), where);
+    }
+
+    Reader reader(model, where, limits);
+    reader.out.report.format = binary ? "glb" : "gltf";
+    std::vector<int> roots;
+    if (!model.scenes.empty()) {
+        const std::size_t s = model.defaultScene >= 0 && std::size_t(model.defaultScene) < model.scenes.size()
+                                  ? std::size_t(model.defaultScene)
+                                  : 0;
+        roots = model.scenes[s].nodes;
+    } else {
+        // No scene: every node that is nobody's child is a root.
+        std::vector<bool> is_child(model.nodes.size(), false);
+        for (const auto& n : model.nodes)
+            for (int c : n.children)
+                if (c >= 0 && std::size_t(c) < is_child.size())
+                    is_child[std::size_t(c)] = true;
+        for (std::size_t i = 0; i < model.nodes.size(); ++i)
+            if (!is_child[i])
+                roots.push_back(int(i));
+    }
+    for (int r : roots)
+        reader.visit(r, glm::dmat4(1.0), 0);
+    if (reader.missing_normals)
+        reader.out.mesh.normals.clear();
+    if (!reader.any_colors)
+        reader.out.mesh.colors.clear();
+    return std::move(reader.out);
+}
+
+// --- export ------------------------------------------------------------------------------
+
+namespace {
+
+template <class T>
+int add_view(tinygltf::Model& model, const T* data, std::size_t bytes, int target) {
+    auto& buf = model.buffers[0].data;
+    while (buf.size() % 4)
+        buf.push_back(0);
+    tinygltf::BufferView bv;
+    bv.buffer = 0;
+    bv.byteOffset = buf.size();
+    bv.byteLength = bytes;
+    bv.target = target;
+    const auto* p = reinterpret_cast<const unsigned char*>(data);
+    buf.insert(buf.end(), p, p + bytes);
+    model.bufferViews.push_back(bv);
+    return int(model.bufferViews.size() - 1);
+}
+
+int add_accessor(tinygltf::Model& model, int view, int component_type, int type, std::size_t count) {
+    tinygltf::Accessor a;
+    a.bufferView = view;
+    a.componentType = component_type;
+    a.type = type;
+    a.count = count;
+    model.accessors.push_back(a);
+    return int(model.accessors.size() - 1);
+}
+
+int vec_type(int components) {
+    switch (components) {
+    case 1: return TINYGLTF_TYPE_SCALAR;
+    case 2: return TINYGLTF_TYPE_VEC2;
+    case 3: return TINYGLTF_TYPE_VEC3;
+    default: return TINYGLTF_TYPE_VEC4;
+    }
+}
+
+} // namespace
+
+void write_glb(const std::filesystem::path& tmp, const Mesh& mesh) {
+    tinygltf::Model model;
+    model.asset.version = "2.0";
+    model.asset.generator = "skybake";
+    model.buffers.resize(1);
+    tinygltf::Primitive prim;
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+    const std::size_t n = mesh.vertex_count();
+
+    const int pv = add_view(model, mesh.positions.data(), n * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER);
+    const int pa = add_accessor(model, pv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n);
+    const Bounds b = compute_bounds(mesh); // POSITION requires min and max
+    model.accessors[std::size_t(pa)].minValues = {b.min.x, b.min.y, b.min.z};
+    model.accessors[std::size_t(pa)].maxValues = {b.max.x, b.max.y, b.max.z};
+    prim.attributes["POSITION"] = pa;
+
+    Mesh copy_for_normals;
+    const std::vector<glm::vec3>* normals = &mesh.normals;
+    if (normals->empty()) {
+        copy_for_normals.positions = mesh.positions;
+        copy_for_normals.indices = mesh.indices;
+        compute_normals(copy_for_normals);
+        normals = &copy_for_normals.normals;
+    }
+    const int nv = add_view(model, normals->data(), n * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER);
+    prim.attributes["NORMAL"] = add_accessor(model, nv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n);
+
+    if (!mesh.colors.empty()) {
+        const int cv = add_view(model, mesh.colors.data(), n * sizeof(glm::vec4), TINYGLTF_TARGET_ARRAY_BUFFER);
+        prim.attributes["COLOR_0"] = add_accessor(model, cv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, n);
+    }
+    for (const auto& a : mesh.attributes) {
+        const int av = add_view(model, a.values.data(), a.values.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
+        prim.attributes[gltf_attribute_name(a.name)] =
+            add_accessor(model, av, TINYGLTF_COMPONENT_TYPE_FLOAT, vec_type(a.components), n);
+    }
+    const int iv = add_view(model, mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t),
+                            TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    prim.indices = add_accessor(model, iv, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
+                                mesh.indices.size());
+
+    tinygltf::Mesh gm;
+    gm.primitives.push_back(prim);
+    model.meshes.push_back(gm);
+    tinygltf::Node node;
+    node.mesh = 0;
+    model.nodes.push_back(node);
+    tinygltf::Scene scene;
+    scene.nodes.push_back(0);
+    model.scenes.push_back(scene);
+    model.defaultScene = 0;
+
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out)
+        throw Error("cannot create file", tmp.string());
+    tinygltf::TinyGLTF writer;
+    if (!writer.WriteGltfSceneToStream(&model, out, false, true) || !out.flush())
+        throw Error("cannot write glTF binary", tmp.string());
+}
+
+} // namespace skybake::io

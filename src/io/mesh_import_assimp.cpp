@@ -1,0 +1,113 @@
+// Mesh import through Assimp, for every format except glTF and PLY.
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <fmt/format.h>
+
+#include "io/mesh_internal.h"
+#include "skybake/error.h"
+
+namespace skybake::io {
+
+namespace {
+
+constexpr unsigned kMaxNodeDepth = 256;
+
+struct Flattener {
+    const aiScene* scene;
+    const ImportLimits& limits;
+    const std::string& where;
+    RawImport out;
+    bool any_missing_normals = false;
+    bool any_colors = false;
+
+    void visit(const aiNode* node, const aiMatrix4x4& parent, unsigned depth) {
+        if (depth > kMaxNodeDepth)
+            throw Error(fmt::format("scene graph is deeper than {} levels", kMaxNodeDepth), where);
+        const aiMatrix4x4 world = parent * node->mTransformation;
+        for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+            if (node->mMeshes[i] >= scene->mNumMeshes)
+                throw Error(fmt::format("node '{}' references mesh {} of {}", node->mName.C_Str(), node->mMeshes[i],
+                                        scene->mNumMeshes),
+                            where);
+            append(scene->mMeshes[node->mMeshes[i]], world);
+        }
+        for (unsigned c = 0; c < node->mNumChildren; ++c)
+            visit(node->mChildren[c], world, depth + 1);
+    }
+
+    void append(const aiMesh* m, const aiMatrix4x4& world) {
+        Mesh& mesh = out.mesh;
+        const std::size_t base = mesh.positions.size();
+        check_counts(base + m->mNumVertices, mesh.triangle_count() + m->mNumFaces, limits, where);
+        ++out.report.source_meshes;
+        aiMatrix3x3 normal_matrix(world);
+        normal_matrix.Inverse().Transpose();
+        for (unsigned v = 0; v < m->mNumVertices; ++v) {
+            const aiVector3D p = world * m->mVertices[v];
+            mesh.positions.emplace_back(p.x, p.y, p.z);
+            if (m->mNormals) {
+                const aiVector3D n = normal_matrix * m->mNormals[v];
+                mesh.normals.emplace_back(n.x, n.y, n.z);
+            } else {
+                mesh.normals.emplace_back(0.0f);
+            }
+            if (m->mColors[0]) {
+                const aiColor4D& c = m->mColors[0][v];
+                mesh.colors.emplace_back(c.r, c.g, c.b, c.a);
+            } else {
+                mesh.colors.emplace_back(1.0f);
+            }
+        }
+        any_missing_normals |= m->mNormals == nullptr;
+        any_colors |= m->mColors[0] != nullptr;
+        for (unsigned f = 0; f < m->mNumFaces; ++f) {
+            const aiFace& face = m->mFaces[f];
+            if (face.mNumIndices != 3) {
+                ++out.report.non_triangles;
+                continue;
+            }
+            for (int k = 0; k < 3; ++k) {
+                if (face.mIndices[k] >= m->mNumVertices)
+                    throw Error(fmt::format("face {} uses vertex index {}, but its mesh has {} vertices", f,
+                                            face.mIndices[k], m->mNumVertices),
+                                where);
+                mesh.indices.push_back(std::uint32_t(base + face.mIndices[k]));
+            }
+        }
+    }
+};
+
+} // namespace
+
+RawImport read_assimp(const void* data, std::size_t size, const std::string& extension_hint, const std::string& where,
+                      const ImportLimits& limits, const std::filesystem::path* path) {
+    Assimp::Importer importer;
+    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+    const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
+                           aiProcess_ValidateDataStructure;
+    // From a path, Assimp can follow references to side files (materials, buffers).
+    const aiScene* scene = path ? importer.ReadFile(path->string(), flags)
+                                : importer.ReadFileFromMemory(data, size, flags, extension_hint.c_str());
+    if (!scene) {
+        std::string why = importer.GetErrorString();
+        if (why.empty())
+            why = "unknown reason";
+        throw Error(fmt::format("cannot read mesh: {}", why), where);
+    }
+    if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
+        throw Error("file has no complete geometry (Assimp marked the scene incomplete)", where);
+    if (!scene->mRootNode || scene->mNumMeshes == 0)
+        throw Error("file contains no meshes", where);
+
+    Flattener flat{scene, limits, where, {}};
+    flat.out.report.format = extension_hint;
+    flat.visit(scene->mRootNode, aiMatrix4x4(), 0);
+    if (flat.any_missing_normals)
+        flat.out.mesh.normals.clear();
+    if (!flat.any_colors)
+        flat.out.mesh.colors.clear();
+    return std::move(flat.out);
+}
+
+} // namespace skybake::io

@@ -1,0 +1,39 @@
+// Internal plumbing shared by the mesh readers and writers.
+#pragma once
+
+#include <string>
+
+#include "skybake/mesh.h"
+
+namespace skybake::io {
+
+// A raw import before validation: positions and indices as read, normals
+// either complete or empty.
+struct RawImport {
+    Mesh mesh;
+    ImportReport report;
+};
+
+// Readers. `where` names the source in error messages.
+RawImport read_gltf(const void* data, std::size_t size, bool binary, const std::string& base_dir,
+                    const std::string& where, const ImportLimits& limits);
+RawImport read_ply(const void* data, std::size_t size, const std::string& where, const ImportLimits& limits);
+// With `path`, Assimp reads the file itself (data may be null); otherwise from memory.
+RawImport read_assimp(const void* data, std::size_t size, const std::string& extension_hint, const std::string& where,
+                      const ImportLimits& limits, const std::filesystem::path* path = nullptr);
+
+// Validates a raw import and brings it to the Mesh invariants: throws on
+// emptiness, non-finite coordinates and out-of-range indices; drops
+// degenerate triangles; computes normals when any are missing or unusable.
+Mesh finish_import(RawImport raw, const std::string& where, const ImportLimits& limits, ImportReport* report);
+
+void write_glb(const std::filesystem::path& tmp, const Mesh& mesh);
+void write_ply(const std::filesystem::path& tmp, const Mesh& mesh, PlyEncoding encoding);
+
+// "ao", "bent_normal": lower-case [a-z0-9_], starting with a letter, at most 64 chars.
+bool is_valid_attribute_name(std::string_view name);
+
+// Throws when a count read from a file would exceed the limits.
+void check_counts(std::uint64_t vertices, std::uint64_t triangles, const ImportLimits& limits, const std::string& where);
+
+} // namespace skybake::io
