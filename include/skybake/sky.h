@@ -77,7 +77,8 @@ struct AtmosphereComponent {
 // How each shell of the optical-length table weighs its length (see docs/sky.md).
 enum class TableRule : int {
     Seed = 0,    // seed 000 as printed: S = ρ_i s_i, the density at the shell's outer boundary
-    LogMean = 1, // the mean density over the shell's height; exact for vertical rays
+    Refined = 1, // each shell cut into sub-shells at most H/16 thick, each weighted by its
+                 // mean density (exact for vertical rays); same rows, same recursion
 };
 
 struct Atmosphere {

@@ -1,0 +1,39 @@
+// Internal glue between the public sky API and the shared CPU/GPU maths.
+#pragma once
+
+#include <glm/exponential.hpp>
+#include <glm/geometric.hpp>
+
+#include "skybake/sky.h"
+#include "sky/sky_hd.h"
+
+namespace skybake::sky {
+
+// Flat view of an atmosphere and its tables for the SKYBAKE_HD functions.
+// The result points into `tables`, which must outlive it.
+AtmosphereHD make_atmosphere_hd(const Atmosphere& atmosphere, const OpticalLengthTables& tables);
+
+// Observer state from a radius (km) and the three cosines.
+ObserverHD make_observer(const Atmosphere& atmosphere, double radius_km, double cos_view_zenith, double cos_view_sun,
+                         double cos_sun_zenith);
+
+// Observer state from a sky sample (ρ0 -> altitude of the first component).
+ObserverHD make_observer(const Atmosphere& atmosphere, const SkySample& sample);
+
+// Exact in-scattered radiance (1/sr, per unit irradiance) along the segment
+// from `origin_km` in unit direction `dir` for length_km, with unit sun
+// direction `sun`, all in a planet-centred frame. Also returns the segment's
+// transmittance when `transmittance` is not null.
+glm::dvec3 inscatter_exact(const Atmosphere& atmosphere, const glm::dvec3& origin_km, const glm::dvec3& dir,
+                           double length_km, const glm::dvec3& sun, double tolerance,
+                           glm::dvec3* transmittance = nullptr);
+
+// Exact transmittance of sunlight reaching point_km (0 in the planet's shadow).
+glm::dvec3 sun_transmittance_exact(const Atmosphere& atmosphere, const glm::dvec3& point_km, const glm::dvec3& sun);
+
+// Length of the view ray inside the atmosphere from origin_km along dir: the
+// entry distance (0 inside) and the exit or ground distance. False if it misses.
+bool atmosphere_segment(const Atmosphere& atmosphere, const glm::dvec3& origin_km, const glm::dvec3& dir,
+                        double& enter_km, double& exit_km, bool& hits_ground);
+
+} // namespace skybake::sky

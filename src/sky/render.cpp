@@ -1,0 +1,107 @@
+// Sky images from an observer at any altitude: fisheye, panorama and pinhole
+// views of the sky, the ground and the planet (Pietras & Rudnicki, seed 000,
+// section VII views). Per-pixel work is in render_hd.h.
+#include <cmath>
+
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "skybake/error.h"
+#include "sky/internal.h"
+#include "sky/render_hd.h"
+
+namespace skybake {
+
+namespace {
+
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+// Exact counterpart of sky::shade_ray, in double (slow; for checks).
+glm::dvec3 shade_ray_exact(const Atmosphere& atm, const sky::RenderHD& p, const glm::dvec3& d, double tol) {
+    const glm::dvec3 eye(0.0, 0.0, double(atm.planet_radius_km) + double(p.eye_h));
+    const glm::dvec3 sun = glm::normalize(glm::dvec3(p.sun));
+    double enter, exit;
+    bool ground;
+    glm::dvec3 c(0.0);
+    if (!sky::atmosphere_segment(atm, eye, d, enter, exit, ground)) {
+        if (p.sun_disc_radiance > 0.0f && glm::dot(d, sun) >= double(p.sun_cos_radius))
+            c += glm::dvec3(p.sun_disc_radiance);
+        return c * glm::dvec3(p.irradiance);
+    }
+    glm::dvec3 t;
+    c = sky::inscatter_exact(atm, eye + enter * d, d, exit - enter, sun, tol, &t);
+    if (ground) {
+        const glm::dvec3 g = eye + exit * d;
+        const double cos_sun = glm::dot(glm::normalize(g), sun);
+        if (cos_sun > 0.0)
+            c += glm::dvec3(p.albedo) * (cos_sun / 3.14159265358979323846) * sky::sun_transmittance_exact(atm, g, sun) * t;
+    } else if (p.sun_disc_radiance > 0.0f && glm::dot(d, sun) >= double(p.sun_cos_radius)) {
+        c += sky::sun_transmittance_exact(atm, eye + enter * d, d) * double(p.sun_disc_radiance);
+    }
+    return c * glm::dvec3(p.irradiance);
+}
+
+} // namespace
+
+Image render_sky(const SkyModel& model, const SkyRenderSettings& s) {
+    const Atmosphere& atm = model.atmosphere();
+    if (!(std::isfinite(s.altitude_km) && s.altitude_km >= 0.0 && s.altitude_km < 1e7))
+        throw Error("the observer altitude must be 0 to 1e7 km", "--altitude-km");
+    if (!(std::isfinite(s.sun_elevation_deg) && std::abs(s.sun_elevation_deg) <= 90.0))
+        throw Error("the sun elevation must be in [-90, 90] degrees", "--sun-elevation-deg");
+    if (!std::isfinite(s.sun_azimuth_deg))
+        throw Error("the sun azimuth must be a finite number of degrees", "--sun-azimuth-deg");
+    if (s.view == SkyView::Camera && !(s.fov_deg > 0.0 && s.fov_deg < 180.0))
+        throw Error("the field of view must be in (0, 180) degrees", "--fov");
+    if (!(std::isfinite(s.yaw_deg) && std::isfinite(s.pitch_deg) && std::abs(s.pitch_deg) <= 90.0))
+        throw Error("yaw must be finite and pitch in [-90, 90] degrees", "--yaw/--pitch");
+    if (s.width < 1 || s.height < 1 || s.width > 16384 || s.height > 16384)
+        throw Error("image size must be 1 to 16384 pixels on each side", "--size");
+
+    sky::RenderHD p;
+    p.atm = *static_cast<const sky::AtmosphereHD*>(model.device_view());
+    p.eye_h = float(s.altitude_km);
+    p.eye_r = float(atm.planet_radius_km + s.altitude_km);
+    p.sun = sky::direction_from_angles(float(s.sun_azimuth_deg * kDeg), float(s.sun_elevation_deg * kDeg));
+    p.view = int(s.view);
+    p.forward = sky::direction_from_angles(float(s.yaw_deg * kDeg), float(s.pitch_deg * kDeg));
+    glm::vec3 right = glm::cross(p.forward, glm::vec3(0.0f, 0.0f, 1.0f));
+    if (glm::length(right) < 1e-6f) // looking straight up or down: keep yaw's sideways direction
+        right = glm::vec3(std::sin(float(s.yaw_deg * kDeg)), -std::cos(float(s.yaw_deg * kDeg)), 0.0f);
+    p.right = glm::normalize(right);
+    p.up = glm::cross(p.right, p.forward);
+    p.tan_half_fov = float(std::tan(0.5 * s.fov_deg * kDeg));
+    p.width = s.width;
+    p.height = s.height;
+    p.steps = model.options().steps;
+    p.albedo = glm::vec3(atm.ground_albedo);
+    p.irradiance = glm::vec3(atm.sun_irradiance);
+    p.sun_cos_radius = float(std::cos(atm.sun_angular_radius_rad));
+    p.sun_disc_radiance =
+        s.sun_disc ? float(1.0 / (3.14159265358979323846 * atm.sun_angular_radius_rad * atm.sun_angular_radius_rad))
+                   : 0.0f;
+
+    Image image(s.width, s.height);
+    Progress progress("render", std::uint64_t(s.height));
+    const bool exact = s.method == SkyMethod::Exact;
+    const double tol = model.options().exact_tolerance;
+    parallel_for(std::size_t(s.height), 1, [&](std::size_t y0, std::size_t y1) {
+        for (std::size_t y = y0; y < y1; ++y) {
+            for (int x = 0; x < s.width; ++x) {
+                glm::vec3 d;
+                float* px = image.pixel(x, int(y));
+                if (!sky::pixel_direction(p, x, int(y), d))
+                    continue;
+                const glm::vec3 c = exact ? glm::vec3(shade_ray_exact(atm, p, glm::normalize(glm::dvec3(d)), tol))
+                                          : sky::shade_ray(p, d);
+                px[0] = c.x;
+                px[1] = c.y;
+                px[2] = c.z;
+            }
+            progress.advance();
+        }
+    });
+    progress.finish();
+    return image;
+}
+
+} // namespace skybake
