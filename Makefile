@@ -1,7 +1,7 @@
 # skybake: the two commands.
 #   make demo   install what is missing, build, run the demo on generated data
 #   make test   install what is missing, build, run the whole test suite
-# Other targets: build, test-fast (unit label only), test-sanitize, fuzz, bench,
+# Other targets: build, test-fast (labels unit and io), test-sanitize, fuzz, bench,
 # install, format, clean.
 
 BUILD      ?= build
@@ -32,7 +32,7 @@ test: build
 	$(MAKE) --no-print-directory test-sanitize
 
 test-fast: build
-	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -L unit
+	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -L 'unit|io'
 
 # ASan + UBSan build of the I/O tests (label "io"): hostile files must not crash.
 test-sanitize: deps

@@ -3,7 +3,8 @@
 # Builds one GoogleTest executable per label from the given sources:
 #   *_slow_test.cpp   -> label "slow"
 #   *_gpu_test.cpp/cu -> label "gpu"  (tests call GTEST_SKIP() without a device)
-#   *_io_test.cpp     -> labels "unit;io" (also run under the sanitizer build)
+#   *_io_test.cpp     -> label "io" (unit tests of file I/O; also run under the
+#                        sanitizer build). `ctest -L 'unit|io'` runs both.
 #   other *_test.cpp  -> label "unit"
 # Test names are prefixed with NAME.
 find_package(GTest REQUIRED)
@@ -46,13 +47,11 @@ function(skybake_add_tests name)
       SKYBAKE_ASSIMP_MODELS="/usr/share/assimp/models"
       SKYBAKE_CLI_PATH="$<TARGET_FILE:skybake_cli>")
     skybake_set_warnings(${exe})
-    set(labels ${g})
     if(g STREQUAL "io")
-      set(labels "unit;io")
       set_property(GLOBAL APPEND PROPERTY SKYBAKE_IO_TEST_TARGETS ${exe})
     endif()
     gtest_discover_tests(${exe} TEST_PREFIX "${name}." DISCOVERY_MODE PRE_TEST
-      PROPERTIES LABELS "${labels}" TIMEOUT 600)
+      PROPERTIES LABELS ${g} TIMEOUT 600)
   endforeach()
 endfunction()
 

@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
@@ -183,7 +185,7 @@ Mesh load_impl(const void* data, std::size_t size, const std::string& ext, const
         raw = io::read_gltf(data, size, ext == "glb", base_dir, where, limits);
     else if (ext == "ply")
         raw = io::read_ply(data, size, where, limits);
-    else if (base_dir.empty())
+    else if (io::precheck_for_assimp(ext, data, size, where, limits); base_dir.empty())
         raw = io::read_assimp(data, size, ext, where, limits);
     else { // from a path, so that Assimp can follow side files
         const std::filesystem::path path = where;
@@ -214,6 +216,12 @@ Mesh load_mesh(const std::filesystem::path& path, ImportReport* report, const Im
         throw Error("file is empty", where);
     if (size > limits.max_file_bytes)
         throw Error(fmt::format("file is {} bytes, over the limit of {}", size, limits.max_file_bytes), where);
+    {
+        std::ifstream in(path, std::ios::binary);
+        std::string head(std::min<std::uintmax_t>(size, 4096), '\0');
+        in.read(head.data(), std::streamsize(head.size()));
+        io::precheck_for_assimp(ext, head.data(), std::size_t(size), where, limits);
+    }
     return io::finish_import(io::read_assimp(nullptr, 0, ext, where, limits, &path), where, limits, report);
 }
 

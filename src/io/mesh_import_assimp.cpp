@@ -1,4 +1,9 @@
 // Mesh import through Assimp, for every format except glTF and PLY.
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <string_view>
+
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -79,6 +84,48 @@ struct Flattener {
 };
 
 } // namespace
+
+void precheck_for_assimp(const std::string& ext, const void* data, std::size_t size, const std::string& where,
+                         const ImportLimits& limits) {
+    // OFF: "OFF\n V F E". Assimp trusts F and can spend minutes or all memory
+    // on a file that declares billions of faces; every face needs at least
+    // two characters, every vertex six.
+    if (ext != "off")
+        return;
+    std::string_view text(static_cast<const char*>(data), std::min<std::size_t>(size, 4096));
+    std::size_t pos = 0;
+    auto token = [&]() -> std::string_view {
+        for (;;) {
+            while (pos < text.size() && std::isspace(static_cast<unsigned char>(text[pos])))
+                ++pos;
+            if (pos < text.size() && text[pos] == '#') { // comment to end of line
+                while (pos < text.size() && text[pos] != '\n')
+                    ++pos;
+                continue;
+            }
+            break;
+        }
+        const std::size_t start = pos;
+        while (pos < text.size() && !std::isspace(static_cast<unsigned char>(text[pos])))
+            ++pos;
+        return text.substr(start, pos - start);
+    };
+    std::string_view magic = token();
+    if (magic.size() < 3 || magic.substr(magic.size() - 3) != "OFF")
+        return; // let Assimp explain
+    std::uint64_t counts[2] = {0, 0};
+    for (auto& c : counts) {
+        const std::string_view t = token();
+        const auto r = std::from_chars(t.data(), t.data() + t.size(), c);
+        if (r.ec != std::errc() || r.ptr != t.data() + t.size())
+            throw Error(fmt::format("bad OFF header: expected a count, found '{}'", t), where);
+    }
+    if (counts[0] > size / 6 || counts[1] > size / 2)
+        throw Error(fmt::format("OFF header declares {} vertices and {} faces, more than a {}-byte file can hold",
+                                counts[0], counts[1], size),
+                    where);
+    check_counts(counts[0], counts[1], limits, where);
+}
 
 RawImport read_assimp(const void* data, std::size_t size, const std::string& extension_hint, const std::string& where,
                       const ImportLimits& limits, const std::filesystem::path* path) {

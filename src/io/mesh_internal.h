@@ -22,6 +22,11 @@ RawImport read_ply(const void* data, std::size_t size, const std::string& where,
 RawImport read_assimp(const void* data, std::size_t size, const std::string& extension_hint, const std::string& where,
                       const ImportLimits& limits, const std::filesystem::path* path = nullptr);
 
+// Cheap checks of headers that Assimp would trust (e.g. an OFF face count of
+// billions). `data` holds at least the start of the file. Throws on failure.
+void precheck_for_assimp(const std::string& ext, const void* data, std::size_t size, const std::string& where,
+                         const ImportLimits& limits);
+
 // Validates a raw import and brings it to the Mesh invariants: throws on
 // emptiness, non-finite coordinates and out-of-range indices; drops
 // degenerate triangles; computes normals when any are missing or unusable.

@@ -192,7 +192,8 @@ Mesh bowl(std::uint64_t target) {
     const int rings = std::max(1, int(std::lround(double(target) / (2.0 * seg))));
     Builder b;
     b.grid(seg, rings, [&](double u, double v) -> PN {
-        const double phi = 2 * kPi * u, theta = 0.5 * kPi * (1 - v); // v = 0 at the rim
+        // phi runs clockwise seen from above, so that front faces look inwards.
+        const double phi = -2 * kPi * u, theta = 0.5 * kPi * (1 - v); // v = 0 at the rim
         const glm::dvec3 p(std::sin(theta) * std::cos(phi), -std::cos(theta), std::sin(theta) * std::sin(phi));
         const glm::vec3 pf(p);
         return {pf, -glm::normalize(pf)};

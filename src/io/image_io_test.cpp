@@ -1,0 +1,88 @@
+// Image files and the tone map.
+#include <bit>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "skybake/error.h"
+#include "skybake/image.h"
+
+using namespace skybake;
+namespace fs = std::filesystem;
+
+namespace {
+fs::path temp(const std::string& name) {
+    const fs::path dir = fs::temp_directory_path() / ("skybake-image-test-" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    return dir / name;
+}
+Image gradient(int w, int h) {
+    Image img(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            float* p = img.pixel(x, y);
+            p[0] = float(x) / float(w - 1) * 4.0f; // HDR
+            p[1] = float(y) / float(h - 1);
+            p[2] = 1e-4f * float(x + y);
+        }
+    return img;
+}
+} // namespace
+
+TEST(ImageFiles, ExrKeepsFloatsExactly) {
+    const Image a = gradient(37, 21);
+    save_image(temp("a.exr"), a);
+    const Image b = load_image(temp("a.exr"));
+    ASSERT_EQ(b.width, a.width);
+    ASSERT_EQ(b.height, a.height);
+    for (std::size_t i = 0; i < a.rgb.size(); ++i)
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(a.rgb[i]), std::bit_cast<std::uint32_t>(b.rgb[i])) << i;
+}
+
+TEST(ImageFiles, PngRoundTripsWithinOneCode) {
+    Image a(16, 4);
+    for (std::size_t i = 0; i < a.rgb.size(); ++i)
+        a.rgb[i] = float(i % 17) / 16.0f; // in [0, 1]
+    save_png(temp("a.png"), a, {0.0f, ToneCurve::Clamp});
+    const Image b = load_image(temp("a.png"));
+    for (std::size_t i = 0; i < a.rgb.size(); ++i) {
+        // One 8-bit sRGB code is at most ~1/255 in encoded space.
+        EXPECT_NEAR(linear_to_srgb(b.rgb[i]), linear_to_srgb(a.rgb[i]), 0.5f / 255.0f + 1e-5f);
+    }
+}
+
+TEST(ImageFiles, BadPathsAndExtensions) {
+    const Image a = gradient(4, 4);
+    EXPECT_THROW(save_image(temp("a.bmp"), a), Error);
+    EXPECT_THROW(save_image(temp("missing_dir/a.png"), a), Error);
+    EXPECT_THROW(save_image(temp("empty.png"), Image()), Error);
+    EXPECT_THROW(load_image(temp("nope.exr")), Error);
+    const fs::path junk = temp("junk.png");
+    { std::ofstream(junk) << "not a png"; }
+    EXPECT_THROW(load_image(junk), Error);
+}
+
+TEST(ToneMap, SrgbTransferInverts) {
+    for (float v = 0.0f; v <= 1.0f; v += 1.0f / 64.0f)
+        EXPECT_NEAR(srgb_to_linear(linear_to_srgb(v)), v, 1e-6f);
+    EXPECT_NEAR(linear_to_srgb(0.0031308f), 0.04045f, 1e-5f); // the two branches meet
+}
+
+TEST(ToneMap, CurvesAreMonotonicAndBounded) {
+    for (ToneCurve c : {ToneCurve::Clamp, ToneCurve::Reinhard, ToneCurve::Aces}) {
+        float prev = -1.0f;
+        for (float x = 0.0f; x < 100.0f; x = x * 1.1f + 1e-3f) {
+            const float y = tone_map_value(x, {0.0f, c});
+            EXPECT_GE(y, prev);
+            EXPECT_LE(y, 1.0f);
+            prev = y;
+        }
+    }
+    EXPECT_FLOAT_EQ(tone_map_value(0.5f, {1.0f, ToneCurve::Clamp}), 1.0f); // +1 EV doubles
+    EXPECT_FLOAT_EQ(tone_map_value(1.0f, {0.0f, ToneCurve::Reinhard}), 0.5f);
+    EXPECT_EQ(tone_map_value(std::nanf(""), {}), 0.0f);
+    EXPECT_EQ(tone_map_value(-1.0f, {}), 0.0f);
+    EXPECT_THROW(parse_tone_curve("filmic"), Error);
+}
