@@ -32,6 +32,7 @@ function(skybake_add_module name)
     target_link_libraries(${target} PUBLIC skybake_${dep})
   endforeach()
   target_link_libraries(${target} PRIVATE ${M_LIBS} PUBLIC ${M_PUBLIC_LIBS})
+  target_compile_features(${target} PUBLIC cxx_std_20) # the public headers are C++20
   if(SKYBAKE_HAS_CUDA)
     target_compile_definitions(${target} PUBLIC $<BUILD_INTERFACE:SKYBAKE_HAS_CUDA=1>)
     if(cu)
