@@ -32,6 +32,7 @@ void print_error(const std::string& line) { std::fprintf(stderr, "skybake: error
 int main(int argc, char** argv) {
     CLI::App app{"skybake: precomputed lighting for real-time graphics (neural skies, baked visibility)", "skybake"};
     app.require_subcommand(1);
+    app.fallthrough(); // inherited by sub-commands: -q and --threads work after them too
     app.set_version_flag("--version", version_line(), "Print the version and whether the build has CUDA");
     bool quiet = false;
     int threads = 0;
