@@ -26,7 +26,9 @@ struct RenderHD {
     float tan_half_fov = 1.0f;
     int width = 1, height = 1;
     int steps = 16;
+    int spacing = kStepsGraded;
     glm::vec3 albedo{0.1f};
+    int seed_ground = 0; // 1: the seed's printed surface term, scaled by Σ b_k ρ_k (see surface.cpp)
     glm::vec3 irradiance{1.0f};
     float sun_cos_radius = 1.0f; // cos of the sun's angular radius
     float sun_disc_radiance = 0.0f; // 1/(π θ²) per unit irradiance; 0 hides the disc
@@ -67,7 +69,7 @@ SKYBAKE_HD_INLINE bool pixel_direction(const RenderHD& p, int x, int y, glm::vec
 SKYBAKE_HD_INLINE glm::vec3 shade_ray(const RenderHD& p, const glm::vec3& d) {
     const AtmosphereHD& a = p.atm;
     ObserverHD o{p.eye_r, p.eye_h, d.z, glm::dot(d, p.sun), p.sun.z};
-    glm::vec3 c = seed_sky_sum(a, o, p.steps);
+    glm::vec3 c = seed_sky_sum(a, o, p.steps, p.spacing);
 
     // Ground: first intersection with the sphere R0.
     const float b = p.eye_r * d.z;
@@ -82,6 +84,12 @@ SKYBAKE_HD_INLINE glm::vec3 shade_ray(const RenderHD& p, const glm::vec3& d) {
         const float cos_sun = glm::dot(n, p.sun);
         if (cos_sun > 0.0f) {
             glm::vec3 reflected = p.albedo * (cos_sun / kPi) * sun_transmittance(a, a.R0, 0.0f, cos_sun);
+            if (p.seed_ground) {
+                glm::vec3 b(0.0f);
+                for (int k = 0; k < a.count; ++k)
+                    b += a.comp[k].sca * component_density(a.comp[k], 0.0f);
+                reflected *= b;
+            }
             if (inside)
                 reflected *= segment_transmittance(a, e.r, e.h, e.cv, a.R0, 0.0f, glm::dot(n, d));
             c += reflected;

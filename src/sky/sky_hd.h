@@ -201,20 +201,71 @@ SKYBAKE_HD_INLINE bool enter_atmosphere(const AtmosphereHD& a, ObserverHD& o) {
 //   I = Σ_v Σ_k b_k F_k(β0) ρ_k,v exp(−Σ_k b_k (L_k[ρ0, cos α0] − L_k[ρ_v, cos α_v]
 //                                            + L_k[ρ_v, cos θ_v])) Δv
 //
-// Midpoints v = (j + ½)Δv, j < steps, from the observer to where the view ray
-// leaves the atmosphere or meets the ground. Points in the planet's shadow are
-// skipped. Along the ray (position p = r0 U0 + v V):
+// from the observer to where the view ray leaves the atmosphere or meets the
+// ground. Points in the planet's shadow are skipped. Along the ray (position
+// p = r0 U0 + v V):
 //   r_v = sqrt(r0² + v² + 2 r0 v cos α0),  cos α_v = (r0 cos α0 + v)/r_v,
 //   cos θ_v = (r0 cos θ0 + v cos β0)/r_v.
 // The seed derives cos θ_v with the dihedral angle Λ between the planes U–V
 // and L–V (cos θ_v = cos α_v cos β0 + sin α_v sin β0 cos Λ); projecting p on L
 // gives the same value without the division by sin α0 sin β0, which is
-// singular at the zenith and at the sun (tested in seed_sum_test.cpp).
+// singular at the zenith and at the sun (tested in sky_model_test.cpp).
 // Multiple components (section V): each has its own density ρ_k = profile(h)
 // and table; the seed's printed rescaling ρ2 = ρ1 H2/H1 is not the density of
 // the second component (that is ρ1^(H1/H2)), so each density is recomputed
 // from the altitude instead.
-SKYBAKE_HD_INLINE glm::vec3 seed_sky_sum(const AtmosphereHD& a, ObserverHD o, int steps) {
+//
+// Steps: the seed uses a uniform Δv (kStepsUniform). The default spacing
+// (kStepsGraded) puts the same number of midpoints on a grid graded
+// geometrically away from the ray's lowest point (start, end or tangent
+// point), where the density peaks: v = s((1 + D/s)^t − 1) with t uniform and
+// s about one scale height of the first component along the ray. With 16
+// steps it is ~10x more accurate than uniform steps at the same cost.
+enum : int { kStepsGraded = 0, kStepsUniform = 1 };
+
+struct SumState {
+    glm::vec3 scatter[kMaxComponents];
+    float l_obs[kMaxComponents];
+    float base; // r0² − R0²
+};
+
+SKYBAKE_HD_INLINE void sum_point(const AtmosphereHD& a, const ObserverHD& o, const SumState& st, float v, float dv,
+                                 glm::vec3& result) {
+    float d2 = st.base + v * (v + 2.0f * o.r * o.cv);
+    d2 = d2 > 0.0f ? d2 : 0.0f;
+    const float rv = sqrtf(a.R0 * a.R0 + d2);
+    const float hv = d2 / (rv + a.R0);
+    const float inv_r = 1.0f / rv;
+    const float cav = fminf(fmaxf((o.r * o.cv + v) * inv_r, -1.0f), 1.0f);
+    const float cth = fminf(fmaxf((o.r * o.cs + v * o.cvs) * inv_r, -1.0f), 1.0f);
+    if (in_planet_shadow(rv, cth, a.R0))
+        return;
+    glm::vec3 tau(0.0f), weight(0.0f);
+    for (int k = 0; k < a.count; ++k) {
+        const ComponentHD& c = a.comp[k];
+        const float rho = component_density(c, hv);
+        const float u = table_coordinate(a, c, hv, rho);
+        const float t = st.l_obs[k] - optical_length_lookup(a, c, rv, u, cav) + optical_length_lookup(a, c, rv, u, cth);
+        tau += c.ext * t;
+        weight += st.scatter[k] * rho;
+    }
+    result += weight * (dv * glm::vec3(expf(-tau.x), expf(-tau.y), expf(-tau.z)));
+}
+
+// n midpoints on [v0, v0 ± D] graded from v0 with scale s (dir = ±1).
+SKYBAKE_HD_INLINE void sum_graded(const AtmosphereHD& a, const ObserverHD& o, const SumState& st, float v0, float D,
+                                  float dir, float s, int n, glm::vec3& result) {
+    if (n <= 0 || D <= 0.0f)
+        return;
+    const float w = logf(1.0f + D / s);
+    for (int j = 0; j < n; ++j) {
+        const float t = (float(j) + 0.5f) / float(n);
+        const float e = expf(w * t);
+        sum_point(a, o, st, v0 + dir * s * (e - 1.0f), s * w * e / float(n), result);
+    }
+}
+
+SKYBAKE_HD_INLINE glm::vec3 seed_sky_sum(const AtmosphereHD& a, ObserverHD o, int steps, int spacing = kStepsGraded) {
     glm::vec3 result(0.0f);
     if (!enter_atmosphere(a, o))
         return result;
@@ -222,41 +273,39 @@ SKYBAKE_HD_INLINE glm::vec3 seed_sky_sum(const AtmosphereHD& a, ObserverHD o, in
     const float length = ground >= 0.0f ? ground : distance_to_sphere_exit(o.r, o.cv, a.Rtop);
     if (length <= 0.0f || steps <= 0)
         return result;
-    const float dv = length / float(steps);
 
-    glm::vec3 scatter[kMaxComponents];
-    float l_obs[kMaxComponents];
+    SumState st;
     for (int k = 0; k < a.count; ++k) {
         const ComponentHD& c = a.comp[k];
-        scatter[k] = c.sca * phase_value(c.phase, c.g, o.cvs);
+        st.scatter[k] = c.sca * phase_value(c.phase, c.g, o.cvs);
         const float rho = component_density(c, o.h);
-        l_obs[k] = optical_length_lookup(a, c, o.r, table_coordinate(a, c, o.h, rho), o.cv);
+        st.l_obs[k] = optical_length_lookup(a, c, o.r, table_coordinate(a, c, o.h, rho), o.cv);
     }
     // r_v² − R0² = (r0² − R0²) + v² + 2 r0 v cos α0, kept as a difference for precision.
-    const float base = o.h * (2.0f * a.R0 + o.h);
-    for (int j = 0; j < steps; ++j) {
-        const float v = (float(j) + 0.5f) * dv;
-        float d2 = base + v * (v + 2.0f * o.r * o.cv);
-        d2 = d2 > 0.0f ? d2 : 0.0f;
-        const float rv = sqrtf(a.R0 * a.R0 + d2);
-        const float hv = d2 / (rv + a.R0);
-        const float inv_r = 1.0f / rv;
-        const float cav = fminf(fmaxf((o.r * o.cv + v) * inv_r, -1.0f), 1.0f);
-        const float cth = fminf(fmaxf((o.r * o.cs + v * o.cvs) * inv_r, -1.0f), 1.0f);
-        if (in_planet_shadow(rv, cth, a.R0))
-            continue;
-        glm::vec3 tau(0.0f), weight(0.0f);
-        for (int k = 0; k < a.count; ++k) {
-            const ComponentHD& c = a.comp[k];
-            const float rho = component_density(c, hv);
-            const float u = table_coordinate(a, c, hv, rho);
-            const float t = l_obs[k] - optical_length_lookup(a, c, rv, u, cav) + optical_length_lookup(a, c, rv, u, cth);
-            tau += c.ext * t;
-            weight += scatter[k] * rho;
-        }
-        result += weight * glm::vec3(expf(-tau.x), expf(-tau.y), expf(-tau.z));
+    st.base = o.h * (2.0f * a.R0 + o.h);
+
+    if (spacing == kStepsUniform) {
+        const float dv = length / float(steps);
+        for (int j = 0; j < steps; ++j)
+            sum_point(a, o, st, (float(j) + 0.5f) * dv, dv, result);
+        return result;
     }
-    return result * dv;
+    // The lowest point of the segment and the cosine to the vertical there.
+    float v_low = -o.r * o.cv;
+    v_low = v_low < 0.0f ? 0.0f : (v_low > length ? length : v_low);
+    float d2 = st.base + v_low * (v_low + 2.0f * o.r * o.cv);
+    const float r_low = sqrtf(a.R0 * a.R0 + (d2 > 0.0f ? d2 : 0.0f));
+    const float mu_low = fabsf(o.r * o.cv + v_low) / r_low;
+    const float H = 1.0f / a.comp[0].inv_scale_height;
+    const float s = H / (mu_low + sqrtf(2.0f * H / r_low));
+    const float before = v_low, after = length - v_low;
+    const float wb = logf(1.0f + before / s), wa = logf(1.0f + after / s);
+    int nb = int(float(steps) * wb / (wb + wa) + 0.5f);
+    nb = before > 0.0f && nb < 1 ? 1 : nb;
+    nb = after > 0.0f && nb > steps - 1 ? steps - 1 : nb;
+    sum_graded(a, o, st, v_low, before, -1.0f, s, nb, result);
+    sum_graded(a, o, st, v_low, after, 1.0f, s, steps - nb, result);
+    return result;
 }
 
 // Transmittance along a ray segment from a point A to a point B on the same

@@ -40,6 +40,8 @@ const OpticalLengthTables& SkyModel::tables() const { return impl_->tables; }
 const SkyModelOptions& SkyModel::options() const { return impl_->options; }
 const void* SkyModel::device_view() const { return &impl_->hd; }
 
+int SkyModel::spacing() const { return impl_->options.uniform_steps ? sky::kStepsUniform : sky::kStepsGraded; }
+
 namespace {
 
 // The three directions of a cosine triple in a frame with the observer's
@@ -71,7 +73,7 @@ glm::dvec3 exact_radiance(const Atmosphere& atm, double r0, double cv, double cv
 glm::dvec3 SkyModel::radiance(const SkySample& s, SkyMethod method) const {
     assert(is_valid_sky_sample(s, 1e-4));
     if (method == SkyMethod::Tables)
-        return glm::dvec3(sky::seed_sky_sum(impl_->hd, sky::make_observer(impl_->atmosphere, s), impl_->options.steps));
+        return glm::dvec3(sky::seed_sky_sum(impl_->hd, sky::make_observer(impl_->atmosphere, s), impl_->options.steps, spacing()));
     const double r0 = impl_->atmosphere.planet_radius_km + impl_->atmosphere.altitude_from_density(s.density);
     return exact_radiance(impl_->atmosphere, r0, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith,
                           impl_->options.exact_tolerance);
@@ -80,12 +82,13 @@ glm::dvec3 SkyModel::radiance(const SkySample& s, SkyMethod method) const {
 glm::dvec3 SkyModel::radiance_at_radius(double r0, double cv, double cvs, double cs, SkyMethod method) const {
     if (method == SkyMethod::Tables)
         return glm::dvec3(
-            sky::seed_sky_sum(impl_->hd, sky::make_observer(impl_->atmosphere, r0, cv, cvs, cs), impl_->options.steps));
+            sky::seed_sky_sum(impl_->hd, sky::make_observer(impl_->atmosphere, r0, cv, cvs, cs), impl_->options.steps, spacing()));
     return exact_radiance(impl_->atmosphere, r0, cv, cvs, cs, impl_->options.exact_tolerance);
 }
 
-glm::dvec3 SkyModel::radiance_tables(const SkySample& s, int steps) const {
-    return glm::dvec3(sky::seed_sky_sum(impl_->hd, sky::make_observer(impl_->atmosphere, s), steps));
+glm::dvec3 SkyModel::radiance_tables(const SkySample& s, int steps, bool uniform_steps) const {
+    return glm::dvec3(sky::seed_sky_sum(impl_->hd, sky::make_observer(impl_->atmosphere, s), steps,
+                                        uniform_steps ? sky::kStepsUniform : sky::kStepsGraded));
 }
 
 void evaluate_sky(const SkyModel& model, std::span<const SkySample> samples, std::span<glm::vec3> out,
@@ -95,9 +98,10 @@ void evaluate_sky(const SkyModel& model, std::span<const SkySample> samples, std
         const sky::AtmosphereHD& hd = *static_cast<const sky::AtmosphereHD*>(model.device_view());
         const Atmosphere& atm = model.atmosphere();
         const int steps = model.options().steps;
+        const int spacing = model.options().uniform_steps ? sky::kStepsUniform : sky::kStepsGraded;
         parallel_for(samples.size(), 1024, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i)
-                out[i] = sky::seed_sky_sum(hd, sky::make_observer(atm, samples[i]), steps);
+                out[i] = sky::seed_sky_sum(hd, sky::make_observer(atm, samples[i]), steps, spacing);
         });
         return;
     }

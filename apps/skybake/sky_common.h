@@ -1,0 +1,49 @@
+// Shared flags of the sky sub-commands: choosing an atmosphere and a method.
+#pragma once
+
+#include <string>
+
+#include "cli.h"
+#include "skybake/sky.h"
+
+namespace skybake::cli {
+
+struct AtmosphereFlags {
+    std::string preset;
+    std::string file;
+    double paper_r = 10000.0, paper_m = 10000.0;
+    std::string table_rule; // empty: the atmosphere's own
+
+    void add(CLI::App& sub, bool allow_file = true) {
+        sub.add_option("--preset", preset, "Atmosphere preset: earth, paper, paper-dense");
+        if (allow_file)
+            sub.add_option("--atmosphere", file, "Atmosphere JSON file (see `skybake sky preset`)");
+        sub.add_option("--paper-r", paper_r, "Seed's Rayleigh divisor r for --preset paper (default 10000)");
+        sub.add_option("--paper-m", paper_m, "Seed's Mie divisor m for --preset paper (default 10000)");
+        sub.add_option("--table-rule", table_rule, "Shell density rule of the tables: seed or refined");
+    }
+
+    Atmosphere load() const {
+        if (!preset.empty() && !file.empty())
+            throw Error("give either --preset or --atmosphere, not both", "--preset/--atmosphere");
+        Atmosphere a = file.empty() ? atmosphere_preset(preset.empty() ? "earth" : preset, paper_r, paper_m)
+                                    : load_atmosphere(file);
+        if (table_rule == "seed")
+            a.table_rule = TableRule::Seed;
+        else if (table_rule == "refined")
+            a.table_rule = TableRule::Refined;
+        else if (!table_rule.empty())
+            throw Error("unknown table rule '" + table_rule + "'; use seed or refined", "--table-rule");
+        return a;
+    }
+};
+
+inline SkyMethod parse_sky_method(const std::string& s) {
+    if (s == "tables")
+        return SkyMethod::Tables;
+    if (s == "exact")
+        return SkyMethod::Exact;
+    throw Error("unknown method '" + s + "'; use tables or exact", "--method");
+}
+
+} // namespace skybake::cli

@@ -1,0 +1,109 @@
+// skybake sky render: images of the sky, the ground and the planet.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "commands.h"
+#include "sky_common.h"
+
+namespace skybake::cli {
+
+namespace {
+
+// Exposure (stops) that maps the 98th percentile of luminance to 1.
+double auto_exposure(const Image& img) {
+    std::vector<float> lum;
+    lum.reserve(img.rgb.size() / 3);
+    for (std::size_t i = 0; i + 2 < img.rgb.size(); i += 3) {
+        const float l = 0.2126f * img.rgb[i] + 0.7152f * img.rgb[i + 1] + 0.0722f * img.rgb[i + 2];
+        if (l > 0.0f && std::isfinite(l))
+            lum.push_back(l);
+    }
+    if (lum.empty())
+        return 0.0;
+    const std::size_t k = std::min(lum.size() - 1, std::size_t(double(lum.size()) * 0.98));
+    std::nth_element(lum.begin(), lum.begin() + std::ptrdiff_t(k), lum.end());
+    return -std::log2(double(lum[k]));
+}
+
+} // namespace
+
+void add_sky_render(CLI::App& group) {
+    auto* sub = group.add_subcommand("render", "Render the sky, the ground and the planet (PNG or EXR)");
+    struct Opts {
+        AtmosphereFlags atm;
+        SkyRenderSettings s;
+        std::string view = "fisheye", size = "512x512", output, method = "tables", tone = "aces";
+        double exposure = NAN;
+        bool has_azimuth = false, no_sun = false, json = false;
+        int steps = 16;
+        std::string ground = "lambert";
+    };
+    auto o = std::make_shared<Opts>();
+    o->atm.add(*sub);
+    sub->add_option("--altitude-km", o->s.altitude_km, "Observer altitude above the ground, km")->required();
+    sub->add_option("--sun-elevation-deg", o->s.sun_elevation_deg, "Sun elevation above the observer's horizon")
+        ->required();
+    sub->add_option("--sun-azimuth-deg", o->s.sun_azimuth_deg, "Sun azimuth, degrees from +x towards +y (default 0)");
+    sub->add_option("--view", o->view, "fisheye (upper hemisphere), panorama (360x180) or camera");
+    sub->add_option("--fov", o->s.fov_deg, "Camera: horizontal field of view, degrees (default 90)");
+    sub->add_option("--yaw", o->s.yaw_deg, "Camera: azimuth of the view centre, degrees (default 0)");
+    sub->add_option("--pitch", o->s.pitch_deg, "Camera: elevation of the view centre, degrees (default 0)");
+    sub->add_option("--size", o->size, "Image size WxH (default 512x512)");
+    sub->add_option("-o,--output", o->output, "Output image: .png (tone-mapped sRGB) or .exr (linear)")->required();
+    sub->add_option("--method", o->method, "tables (default) or exact (slow)");
+    sub->add_option("--steps", o->steps, "Steps of the sum per view ray (default 16)");
+    sub->add_option("--exposure", o->exposure, "PNG exposure in stops (default: automatic)");
+    sub->add_option("--tone", o->tone, "PNG tone curve: aces, reinhard or clamp");
+    sub->add_flag("--no-sun", o->no_sun, "Do not draw the sun disc");
+    sub->add_option("--ground", o->ground, "Ground model: lambert (physical, default) or seed (the seed's b-scaled term)");
+    add_json_flag(*sub, o->json);
+    sub->callback([o] {
+        const Atmosphere atm = o->atm.load();
+        if (o->view == "fisheye")
+            o->s.view = SkyView::Fisheye;
+        else if (o->view == "panorama")
+            o->s.view = SkyView::Panorama;
+        else if (o->view == "camera")
+            o->s.view = SkyView::Camera;
+        else
+            throw Error("unknown view '" + o->view + "'; use fisheye, panorama or camera", "--view");
+        parse_size(o->size, o->s.width, o->s.height, "--size");
+        o->s.method = parse_sky_method(o->method);
+        o->s.sun_disc = !o->no_sun;
+        if (o->ground != "lambert" && o->ground != "seed")
+            throw Error("unknown ground model '" + o->ground + "'; use lambert or seed", "--ground");
+        o->s.seed_ground = o->ground == "seed";
+        ToneMap tm;
+        tm.curve = parse_tone_curve(o->tone);
+        const std::string ext = std::filesystem::path(o->output).extension().string();
+        if (ext != ".png" && ext != ".exr")
+            throw Error("the output must end in .png or .exr", o->output);
+        SkyModelOptions opts;
+        opts.steps = o->steps;
+        const auto t0 = std::chrono::steady_clock::now();
+        const SkyModel model(atm, opts);
+        const Image img = render_sky(model, o->s);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        tm.exposure_ev = std::isfinite(o->exposure) ? float(o->exposure) : float(auto_exposure(img));
+        save_image(o->output, img, tm);
+        info("{}x{} {} view from {} km, sun at {} deg: {:.2f} s -> {} (exposure {:+.2f} EV)", o->s.width, o->s.height,
+             o->view, o->s.altitude_km, o->s.sun_elevation_deg, seconds, o->output, tm.exposure_ev);
+        if (o->json)
+            print_json({{"atmosphere", atm.name},
+                        {"view", o->view},
+                        {"width", o->s.width},
+                        {"height", o->s.height},
+                        {"altitude_km", o->s.altitude_km},
+                        {"sun_elevation_deg", o->s.sun_elevation_deg},
+                        {"method", o->method},
+                        {"ground", o->ground},
+                        {"exposure_ev", tm.exposure_ev},
+                        {"seconds", seconds},
+                        {"output", o->output}});
+    });
+}
+
+SKYBAKE_CLI_COMMAND("sky", add_sky_render)
+
+} // namespace skybake::cli

@@ -1,0 +1,53 @@
+// Sky samples per second: the seed's sum over its tables (at several step
+// counts) and the exact quadrature, on random valid samples of the input
+// space. The baseline is the tables path at the default 16 steps; counters
+// report samples/s and, for the others, the ratio to that baseline.
+#include <benchmark/benchmark.h>
+
+#include "skybake/sky.h"
+
+using namespace skybake;
+
+namespace {
+
+const std::vector<SkySample>& samples() {
+    static const std::vector<SkySample> s = draw_sky_samples(200000, 1);
+    return s;
+}
+
+void run_tables(benchmark::State& state, const char* preset) {
+    SkyModelOptions o;
+    o.steps = int(state.range(0));
+    const SkyModel model(atmosphere_preset(preset), o);
+    const auto& s = samples();
+    std::vector<glm::vec3> out(s.size());
+    for (auto _ : state) {
+        evaluate_sky(model, s, out, SkyMethod::Tables);
+        benchmark::DoNotOptimize(out.data());
+    }
+    state.counters["samples_per_s"] =
+        benchmark::Counter(double(s.size()) * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+
+void BM_SkyTablesPaper(benchmark::State& state) { run_tables(state, "paper"); }
+void BM_SkyTablesEarth(benchmark::State& state) { run_tables(state, "earth"); }
+
+void BM_SkyExactPaper(benchmark::State& state) {
+    const SkyModel model(atmosphere_preset("paper"));
+    const std::vector<SkySample> s(samples().begin(), samples().begin() + 200);
+    std::vector<glm::vec3> out(s.size());
+    for (auto _ : state) {
+        evaluate_sky(model, s, out, SkyMethod::Exact);
+        benchmark::DoNotOptimize(out.data());
+    }
+    state.counters["samples_per_s"] =
+        benchmark::Counter(double(s.size()) * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+
+} // namespace
+
+BENCHMARK(BM_SkyTablesPaper)->Arg(8)->Arg(16)->Arg(32)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SkyTablesEarth)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_SkyExactPaper)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+
+BENCHMARK_MAIN();

@@ -1,0 +1,163 @@
+// End-to-end tests of `skybake sky ...`: presets, optical lengths, CSV
+// evaluation with its errors, rendering.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.h"
+
+using skybake::test::run_cli;
+using skybake::test::temp_dir;
+
+namespace {
+
+std::string write(const std::string& dir, const std::string& name, const std::string& text) {
+    const std::string path = dir + "/" + name;
+    std::ofstream(path) << text;
+    return path;
+}
+
+std::string read(const std::string& path) {
+    std::ifstream f(path);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+double last_line_number(const std::string& out) {
+    std::string s = out;
+    while (!s.empty() && s.back() == '\n')
+        s.pop_back();
+    return std::stod(s.substr(s.rfind('\n') + 1));
+}
+
+} // namespace
+
+TEST(SkyCli, PresetRoundTripsThroughAFile) {
+    const std::string dir = temp_dir("sky_preset");
+    auto r = run_cli({"sky", "preset", "earth"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["planet_radius_km"], 6360.0);
+    EXPECT_EQ(j["components"].size(), 3u);
+    const std::string file = write(dir, "earth.json", r.out);
+    // The same optical length from the preset and from the saved file.
+    auto a = run_cli({"sky", "optical-length", "--preset", "earth", "--density", "0.5", "--cos-zenith", "0.3"});
+    auto b = run_cli({"sky", "optical-length", "--atmosphere", file, "--density", "0.5", "--cos-zenith", "0.3"});
+    ASSERT_EQ(a.exit_code, 0) << a.err;
+    ASSERT_EQ(b.exit_code, 0) << b.err;
+    EXPECT_EQ(last_line_number(a.out), last_line_number(b.out));
+}
+
+TEST(SkyCli, OpticalLengthStraightUpIsTheScaleHeight) {
+    // From the ground straight up: H (1 − e^(−h_top/H)); paper: H = 8.3, top 100 km.
+    auto r = run_cli({"sky", "optical-length", "--preset", "paper", "--density", "1", "--cos-zenith", "1", "--method",
+                      "exact"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NEAR(last_line_number(r.out), 8.3 * (1 - std::exp(-100 / 8.3)), 1e-6);
+    auto t = run_cli({"sky", "optical-length", "--preset", "paper", "--density", "1", "--cos-zenith", "1",
+                      "--component", "1", "--table-rule", "refined"});
+    ASSERT_EQ(t.exit_code, 0) << t.err;
+    EXPECT_NEAR(last_line_number(t.out), 1.6, 1e-3);
+}
+
+TEST(SkyCli, OpticalLengthJson) {
+    auto r = run_cli({"sky", "optical-length", "--preset", "earth", "--density", "1", "--cos-zenith", "-0.5",
+                      "--method", "exact", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_TRUE(j["hits_ground"].get<bool>());
+}
+
+TEST(SkyCli, EvalWritesOneRowPerSample) {
+    const std::string dir = temp_dir("sky_eval");
+    const std::string in = write(dir, "in.csv",
+                                 "cos_view_zenith,cos_view_sun,cos_sun_zenith,density\n"
+                                 "1,1,1,1\n"
+                                 "0.5,0.2,0.3,0.9\n"
+                                 "\n"
+                                 "0.0,0.0,-0.9,1\n");
+    for (const char* method : {"tables", "exact"}) {
+        const std::string out = dir + "/out_" + method + ".csv";
+        auto r = run_cli({"sky", "eval", "--preset", "earth", "--method", method, "--input", in, "--output", out,
+                          "--json"});
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        EXPECT_EQ(nlohmann::json::parse(r.out)["samples"], 3);
+        std::istringstream rows(read(out));
+        std::string line;
+        std::getline(rows, line);
+        EXPECT_EQ(line, "r,g,b");
+        std::vector<std::array<double, 3>> v;
+        while (std::getline(rows, line)) {
+            std::array<double, 3> c{};
+            ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf", &c[0], &c[1], &c[2]), 3) << line;
+            v.push_back(c);
+        }
+        ASSERT_EQ(v.size(), 3u);
+        EXPECT_GT(v[0][2], v[0][0]); // blue zenith
+        EXPECT_EQ(v[2][0], 0.0);     // night: the sun 64 degrees below the horizon
+    }
+}
+
+TEST(SkyCli, EvalErrorsNameTheLine) {
+    const std::string dir = temp_dir("sky_eval_bad");
+    struct Case {
+        const char* text;
+        const char* expect;
+    } cases[] = {
+        {"1,1,1,1\n1,0.5,-0.5,1\n", "line 2"},           // impossible triple
+        {"1,1,1,1\n0,0,0,0\n", "line 2"},                // density 0
+        {"h1,h2,h3,h4\n1,1,1,1.5\n", "line 2"},          // density > 1
+        {"1,1,1,1\n\n0.5,abc,0,1\n", "line 3"},          // not a number
+        {"1,1,1\n", "line 1"},                            // three fields
+    };
+    for (const Case& c : cases) {
+        const std::string in = write(dir, "in.csv", c.text);
+        const std::string out = dir + "/out.csv";
+        auto r = run_cli({"sky", "eval", "--input", in, "--output", out});
+        EXPECT_EQ(r.exit_code, 1) << c.text;
+        EXPECT_EQ(r.err_lines(), 1) << r.err;
+        EXPECT_NE(r.err.find(c.expect), std::string::npos) << r.err;
+        EXPECT_FALSE(std::filesystem::exists(out)) << "no output on error";
+    }
+}
+
+TEST(SkyCli, BadFlagsAreOneLineErrors) {
+    auto a = run_cli({"sky", "optical-length", "--preset", "mars", "--density", "1", "--cos-zenith", "1"});
+    EXPECT_EQ(a.exit_code, 1);
+    EXPECT_EQ(a.err_lines(), 1) << a.err;
+    auto b = run_cli({"sky", "optical-length", "--preset", "earth", "--density", "1.5", "--cos-zenith", "1"});
+    EXPECT_EQ(b.exit_code, 1);
+    EXPECT_NE(b.err.find("--density"), std::string::npos);
+    const std::string dir = temp_dir("sky_bad_json");
+    const std::string bad = write(dir, "bad.json", "{\"planet_radius_km\": 6360, \"top_radius_km\": 6000}");
+    auto c = run_cli({"sky", "optical-length", "--atmosphere", bad, "--density", "1", "--cos-zenith", "1"});
+    EXPECT_EQ(c.exit_code, 1);
+    EXPECT_EQ(c.err_lines(), 1) << c.err;
+    EXPECT_NE(c.err.find("bad.json"), std::string::npos) << c.err;
+}
+
+TEST(SkyCli, RenderWritesImages) {
+    const std::string dir = temp_dir("sky_render");
+    for (const char* view : {"fisheye", "panorama", "camera"}) {
+        const std::string out = dir + "/" + view + ".png";
+        auto r = run_cli({"sky", "render", "--preset", "earth", "--altitude-km", "0", "--sun-elevation-deg", "20",
+                          "--view", view, "--size", "48x32", "-o", out, "--json"});
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        EXPECT_TRUE(std::filesystem::exists(out));
+        EXPECT_EQ(nlohmann::json::parse(r.out)["width"], 48);
+    }
+    const std::string exr = dir + "/space.exr";
+    auto s = run_cli({"sky", "render", "--preset", "paper-dense", "--altitude-km", "20000", "--sun-elevation-deg", "0",
+                      "--view", "camera", "--pitch", "-90", "--fov", "60", "--size", "32x32", "-o", exr});
+    ASSERT_EQ(s.exit_code, 0) << s.err;
+    EXPECT_TRUE(std::filesystem::exists(exr));
+    auto bad = run_cli({"sky", "render", "--preset", "earth", "--altitude-km", "0", "--sun-elevation-deg", "20",
+                        "--view", "fish", "-o", dir + "/x.png"});
+    EXPECT_EQ(bad.exit_code, 1);
+    EXPECT_EQ(bad.err_lines(), 1);
+}
