@@ -275,6 +275,18 @@ TEST(HostileInput, PlyTruncatedAndGarbage) {
     EXPECT_THROW(load_text("not a ply", "ply"), Error);
 }
 
+TEST(HostileInput, PlyPartialNormalsAreIgnored) {
+    // Found by the fuzzer: "nx" without "ny"/"nz" once wrote to an empty array.
+    const std::string ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                            "property float z\nproperty float nx\nelement face 1\n"
+                            "property list uchar int vertex_indices\nend_header\n"
+                            "0 0 0 1\n1 0 0 1\n0 1 0 1\n3 0 1 2\n";
+    ImportReport rep;
+    const Mesh m = load_mesh_from_memory(ply.data(), ply.size(), "ply", &rep);
+    EXPECT_FALSE(rep.normals_present);
+    EXPECT_FLOAT_EQ(m.normals[0].z, 1.0f);
+}
+
 TEST(HostileInput, DegenerateTrianglesAreSkippedAndCounted) {
     const std::string ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
                             "property float z\nelement face 3\nproperty list uchar int vertex_indices\nend_header\n"

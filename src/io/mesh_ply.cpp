@@ -295,6 +295,10 @@ RawImport read_ply(const void* data, std::size_t size, const std::string& where,
             if (!(has_pos[0] && has_pos[1] && has_pos[2]))
                 throw Error("PLY vertex element lacks x, y or z", where);
             const bool normals = has_nrm[0] && has_nrm[1] && has_nrm[2];
+            if (!normals) // a partial normal (nx without nz) is ignored
+                for (Slot& s : slots)
+                    if (s.kind == Nrm)
+                        s.kind = Skip;
             mesh.positions.resize(e.count);
             if (normals)
                 mesh.normals.resize(e.count);

@@ -28,6 +28,6 @@ for f in "$models"/OBJ/*.obj; do seed 3 "$f"; done
 for f in "$models"/OFF/*.off; do seed 4 "$f"; done
 for f in "$models"/STL/*.stl; do seed 5 "$f"; done
 cd "$here"
-ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 \
+ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 LSAN_OPTIONS=suppressions=$here/lsan.supp \
   "$build/fuzz_mesh_loader" -max_total_time="$secs" -max_len=65536 -rss_limit_mb=4096 -timeout=20 \
   -print_final_stats=1 "$corpus"

@@ -1,4 +1,5 @@
-// End-to-end: `skybake mesh ...` as a user runs it.
+// End-to-end: `skybake mesh ...` as a user runs it. Labelled "io", so the
+// sanitizer build runs these against an ASan + UBSan skybake binary too.
 #include <filesystem>
 #include <fstream>
 
