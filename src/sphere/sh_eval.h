@@ -1,0 +1,64 @@
+// Real orthonormal spherical harmonics, evaluated from Cartesian coordinates
+// with the normalised associated-Legendre recurrence (e.g. Schaeffer 2013,
+// "Efficient spherical harmonic transforms aimed at pseudospectral numerical
+// simulations", eq. 2-4) and (x + iy)^m for the azimuthal factors, so that the
+// whole evaluation is polynomial in x, y, z: no trigonometry, no pole
+// singularity, and it works with float, double or dual numbers alike.
+//
+// Convention (skybake/sh.h): no Condon–Shortley phase, Y_1,-1 ∝ y, Y_10 ∝ z,
+// Y_11 ∝ x; index l² + l + m.
+#pragma once
+
+#include <cmath>
+
+#include "core/hd.h"
+
+namespace skybake::sphere {
+
+// All Y_lm(x, y, z) for l ≤ lmax into out[(lmax+1)²]. (x, y, z): unit vector.
+// T: float, double, or any type with +, −, × by T and by double.
+template <class T>
+SKYBAKE_HD_INLINE void sh_eval_hd(int lmax, T x, T y, T z, T* out) {
+    using std::sqrt;
+    // Q̄_m^m: normalised P_m^m / sin^m θ, Q̄_0^0 = 1/√(4π).
+    double pmm = 0.28209479177387814; // 1/(2√π)
+    T c = T(1.0), s = T(0.0);         // cos(mφ) sin^m θ, sin(mφ) sin^m θ
+    for (int m = 0; m <= lmax; ++m) {
+        if (m > 0) {
+            pmm *= sqrt((2.0 * m + 1.0) / (2.0 * m));
+            const T c_next = x * c - y * s;
+            s = x * s + y * c;
+            c = c_next;
+        }
+        // Band l = m, then l = m + 1, then the three-term recurrence in l.
+        T q_lm2 = T(0.0);
+        T q_lm1 = T(pmm);
+        const double sqrt2 = m == 0 ? 1.0 : 1.4142135623730951;
+        for (int l = m; l <= lmax; ++l) {
+            T q;
+            if (l == m) {
+                q = q_lm1;
+            } else if (l == m + 1) {
+                q = z * q_lm1 * sqrt(2.0 * m + 3.0);
+                q_lm2 = q_lm1;
+                q_lm1 = q;
+            } else {
+                const double ll = double(l) * l, mm = double(m) * m, l1 = double(l - 1);
+                const double a = sqrt((4.0 * ll - 1.0) / (ll - mm));
+                const double b = sqrt((l1 * l1 - mm) / (4.0 * l1 * l1 - 1.0));
+                q = (z * q_lm1 - q_lm2 * b) * a;
+                q_lm2 = q_lm1;
+                q_lm1 = q;
+            }
+            const int centre = l * l + l;
+            if (m == 0) {
+                out[centre] = q;
+            } else {
+                out[centre + m] = q * c * sqrt2;
+                out[centre - m] = q * s * sqrt2;
+            }
+        }
+    }
+}
+
+} // namespace skybake::sphere
