@@ -72,6 +72,12 @@ struct ImportLimits {
     std::uint64_t max_file_bytes = std::uint64_t(4) << 30; // 4 GiB
     std::uint64_t max_vertices = 200'000'000;
     std::uint64_t max_triangles = 200'000'000;
+    // Formats read through Assimp are parsed in a child process, so that a
+    // parser crash or hang on a malformed file becomes an error, not a crash
+    // of the caller. The child gets these limits (0: none).
+    bool isolate_parsers = true;
+    unsigned parser_timeout_s = 300;
+    std::uint64_t parser_memory_bytes = std::uint64_t(32) << 30; // address space, 32 GiB
 };
 
 struct ImportReport {

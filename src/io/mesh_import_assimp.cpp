@@ -127,8 +127,10 @@ void precheck_for_assimp(const std::string& ext, const void* data, std::size_t s
     check_counts(counts[0], counts[1], limits, where);
 }
 
-RawImport read_assimp(const void* data, std::size_t size, const std::string& extension_hint, const std::string& where,
-                      const ImportLimits& limits, const std::filesystem::path* path) {
+namespace {
+
+RawImport read_assimp_here(const void* data, std::size_t size, const std::string& extension_hint,
+                           const std::string& where, const ImportLimits& limits, const std::filesystem::path* path) {
     Assimp::Importer importer;
     importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
     const unsigned flags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
@@ -155,6 +157,15 @@ RawImport read_assimp(const void* data, std::size_t size, const std::string& ext
     if (!flat.any_colors)
         flat.out.mesh.colors.clear();
     return std::move(flat.out);
+}
+
+} // namespace
+
+RawImport read_assimp(const void* data, std::size_t size, const std::string& extension_hint, const std::string& where,
+                      const ImportLimits& limits, const std::filesystem::path* path) {
+    // Assimp is not robust against hostile files: isolate it (see isolated_import.cpp).
+    return run_isolated([&] { return read_assimp_here(data, size, extension_hint, where, limits, path); }, where,
+                        limits);
 }
 
 } // namespace skybake::io

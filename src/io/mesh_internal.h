@@ -1,6 +1,7 @@
 // Internal plumbing shared by the mesh readers and writers.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "skybake/mesh.h"
@@ -21,6 +22,12 @@ RawImport read_ply(const void* data, std::size_t size, const std::string& where,
 // With `path`, Assimp reads the file itself (data may be null); otherwise from memory.
 RawImport read_assimp(const void* data, std::size_t size, const std::string& extension_hint, const std::string& where,
                       const ImportLimits& limits, const std::filesystem::path* path = nullptr);
+
+// Runs parse() in a forked child with limits.parser_timeout_s and
+// limits.parser_memory_bytes, and returns its result; a crash, a timeout or an
+// allocation failure in the child throws skybake::Error. Runs parse() in this
+// process when limits.isolate_parsers is false.
+RawImport run_isolated(const std::function<RawImport()>& parse, const std::string& where, const ImportLimits& limits);
 
 // Cheap checks of headers that Assimp would trust (e.g. an OFF face count of
 // billions). `data` holds at least the start of the file. Throws on failure.

@@ -2,6 +2,7 @@
 // Labelled "io": these also run under AddressSanitizer + UBSan (make test-sanitize).
 #include <bit>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -325,6 +326,30 @@ TEST(HostileInput, GltfExternalFilesCannotBeReachedFromMemory) {
       "accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"}],
       "meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]})";
     EXPECT_THROW(load_text(gltf, "gltf"), Error);
+}
+
+TEST(HostileInput, AParserCrashBecomesAnError) {
+    // Found by the fuzzer: this OBJ makes Debian's Assimp 5.2.5 segfault when
+    // read from memory. The parse runs in a child process, so it is an Error.
+    const fs::path p = fs::path(SKYBAKE_SOURCE_DIR) / "tests/data/fuzz/assimp_obj_crash.obj";
+    std::ifstream in(p, std::ios::binary);
+    const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_FALSE(data.empty());
+    EXPECT_THROW(load_mesh_from_memory(data.data(), data.size(), "obj"), Error);
+    EXPECT_THROW(load_mesh(p), Error);
+}
+
+TEST(HostileInput, IsolatedAndInProcessParsesAgree) {
+    ImportLimits here;
+    here.isolate_parsers = false;
+    const fs::path p = kModels / "OBJ/spider.obj";
+    ImportReport ra, rb;
+    const Mesh a = load_mesh(p, &ra), b = load_mesh(p, &rb, here);
+    EXPECT_EQ(a.indices, b.indices);
+    ASSERT_EQ(a.positions.size(), b.positions.size());
+    EXPECT_EQ(0, std::memcmp(a.positions.data(), b.positions.data(), a.positions.size() * sizeof(glm::vec3)));
+    EXPECT_EQ(ra.degenerate_triangles, rb.degenerate_triangles);
+    EXPECT_EQ(ra.source_meshes, rb.source_meshes);
 }
 
 TEST(HostileInput, LimitsAreEnforced) {
