@@ -36,9 +36,28 @@ double gamma_sign(double z) {
 
 } // namespace
 
+namespace sphere {
+
+const double* sh_recurrence_table() {
+    static const std::vector<double> table = [] {
+        std::vector<double> t(std::size_t(2 * sh_count(kShMaxL)), 0.0);
+        for (int l = 2; l <= kShMaxL; ++l)
+            for (int m = 0; m <= l - 2; ++m) {
+                const double ll = double(l) * l, mm = double(m) * m, l1 = double(l - 1);
+                t[std::size_t(sh_recurrence_index(l, m))] = std::sqrt((4.0 * ll - 1.0) / (ll - mm));
+                t[std::size_t(sh_recurrence_index(l, m) + 1)] = std::sqrt((l1 * l1 - mm) / (4.0 * l1 * l1 - 1.0));
+            }
+        return t;
+    }();
+    return table.data();
+}
+
+} // namespace sphere
+
 void sh_eval(int lmax, const glm::dvec3& dir, double* out) {
     assert(lmax >= 0 && lmax <= kShMaxL);
-    sphere::sh_eval_hd<double>(lmax, dir.x, dir.y, dir.z, out);
+    static const double* table = sphere::sh_recurrence_table();
+    sphere::sh_eval_hd<double>(lmax, dir.x, dir.y, dir.z, out, table);
 }
 
 std::vector<double> sh_eval(int lmax, const glm::dvec3& dir) {

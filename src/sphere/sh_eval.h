@@ -15,10 +15,15 @@
 
 namespace skybake::sphere {
 
+// Recurrence factors a_lm, b_lm of the loop below, stored at 2·(l² + l + m) and +1
+// for 0 ≤ m ≤ l − 2; sh_recurrence_table() in sh.cpp fills them. Passing a table
+// saves two square roots per coefficient; nullptr computes them on the fly.
+SKYBAKE_HD_INLINE int sh_recurrence_index(int l, int m) { return 2 * (l * l + l + m); }
+
 // All Y_lm(x, y, z) for l ≤ lmax into out[(lmax+1)²]. (x, y, z): unit vector.
 // T: float, double, or any type with +, −, × by T and by double.
 template <class T>
-SKYBAKE_HD_INLINE void sh_eval_hd(int lmax, T x, T y, T z, T* out) {
+SKYBAKE_HD_INLINE void sh_eval_hd(int lmax, T x, T y, T z, T* out, const double* table = nullptr) {
     using std::sqrt;
     // Q̄_m^m: normalised P_m^m / sin^m θ, Q̄_0^0 = 1/√(4π).
     double pmm = 0.28209479177387814; // 1/(2√π)
@@ -43,9 +48,15 @@ SKYBAKE_HD_INLINE void sh_eval_hd(int lmax, T x, T y, T z, T* out) {
                 q_lm2 = q_lm1;
                 q_lm1 = q;
             } else {
-                const double ll = double(l) * l, mm = double(m) * m, l1 = double(l - 1);
-                const double a = sqrt((4.0 * ll - 1.0) / (ll - mm));
-                const double b = sqrt((l1 * l1 - mm) / (4.0 * l1 * l1 - 1.0));
+                double a, b;
+                if (table) {
+                    a = table[sh_recurrence_index(l, m)];
+                    b = table[sh_recurrence_index(l, m) + 1];
+                } else {
+                    const double ll = double(l) * l, mm = double(m) * m, l1 = double(l - 1);
+                    a = sqrt((4.0 * ll - 1.0) / (ll - mm));
+                    b = sqrt((l1 * l1 - mm) / (4.0 * l1 * l1 - 1.0));
+                }
                 q = (z * q_lm1 - q_lm2 * b) * a;
                 q_lm2 = q_lm1;
                 q_lm1 = q;
@@ -60,5 +71,9 @@ SKYBAKE_HD_INLINE void sh_eval_hd(int lmax, T x, T y, T z, T* out) {
         }
     }
 }
+
+// Host copy of the recurrence factors up to kShMaxL (sh.cpp); copy it to the GPU
+// for kernels that evaluate high bands.
+const double* sh_recurrence_table();
 
 } // namespace skybake::sphere
