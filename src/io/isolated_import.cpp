@@ -46,7 +46,8 @@ struct Writer {
     template <class T>
     void vec(const std::vector<T>& v) {
         pod(std::uint64_t(v.size()));
-        buf.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+        if (!v.empty())
+            buf.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
     }
 };
 
@@ -79,7 +80,8 @@ struct Reader {
         if (n > (buf.size() - pos) / sizeof(T))
             throw Error("the isolated importer sent a truncated result", where);
         std::vector<T> v(n);
-        std::memcpy(v.data(), buf.data() + pos, n * sizeof(T));
+        if (n > 0) // memcpy to an empty vector's null data() is undefined
+            std::memcpy(v.data(), buf.data() + pos, n * sizeof(T));
         pos += n * sizeof(T);
         return v;
     }
