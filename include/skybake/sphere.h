@@ -159,13 +159,17 @@ glm::dmat3 vertex_rotation(std::uint32_t vertex, std::uint64_t seed);
 //
 // A spherical t-design is an equal-weight rule with Σ_j Y_lm(x_j) = 0 for all
 // 1 ≤ l ≤ t, i.e. precision t. skybake computes them itself, by Levenberg–Marquardt
-// on those equations (Gräf & Potts 2011 style), from a Fibonacci start; there are
-// design_point_count(t) = ⌈((t+1)² + 2)/2⌉ points (≈ t²/2, e.g. 243 for t = 21).
+// on those equations (Gräf & Potts 2011 style) from a Fibonacci start. Designs are
+// antipodal ({±x_j}, Womersley's "symmetric" designs): the odd bands vanish by
+// symmetry, a design for even t is also one for t + 1, and the point count is
+// design_point_count(t) ≈ t²/2 + t/2 (234 for t = 21, where Hardin & Sloane list
+// 240), or a few more if the optimiser needed slack to leave a local minimum.
 //
 // Computed designs are cached as text files in design_cache_dir(): the folder in
 // $SKYBAKE_CACHE_DIR if set, else $XDG_CACHE_HOME/skybake, else ~/.cache/skybake.
 // Files are written atomically, and checked again when read (a stale or damaged
 // file is recomputed).
+// The smallest point count the optimiser tries for strength t (even, 2 for t = 1).
 int design_point_count(int t);
 std::filesystem::path design_cache_dir();
 // Cached design (memory, then disk, then computed and stored). 1 ≤ t ≤ 40.
