@@ -4,6 +4,7 @@
 #include <string>
 
 #include "cli.h"
+#include "skybake/neural.h"
 #include "skybake/sky.h"
 
 namespace skybake::cli {
@@ -35,6 +36,26 @@ struct AtmosphereFlags {
         else if (!table_rule.empty())
             throw Error("unknown table rule '" + table_rule + "'; use seed or refined", "--table-rule");
         return a;
+    }
+};
+
+// --model weights.json: a trained neural sky in place of the sky model. The
+// weights file carries its atmosphere, so --preset/--atmosphere/--method and
+// the table flags do not apply.
+struct ModelFlag {
+    std::string path;
+
+    void add(CLI::App& sub) {
+        sub.add_option("--model", path, "Use a trained neural sky (weights JSON from `skybake sky train`)");
+    }
+    bool active() const { return !path.empty(); }
+    NeuralSky load(const CLI::App& sub, const AtmosphereFlags& atm) const {
+        if (!atm.preset.empty() || !atm.file.empty())
+            throw Error("a weights file carries its own atmosphere; drop --preset/--atmosphere", "--model");
+        for (const char* flag : {"--method", "--table-rule", "--steps", "--uniform-steps", "--shells", "--cosines"})
+            if (sub.get_option_no_throw(flag) && sub.get_option_no_throw(flag)->count() > 0)
+                throw Error(std::string(flag) + " does not apply to a neural sky", "--model");
+        return load_neural_sky(path);
     }
 };
 

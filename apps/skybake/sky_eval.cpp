@@ -86,12 +86,14 @@ void add_sky_eval(CLI::App& group) {
     auto* sub = group.add_subcommand("eval", "Evaluate the sky colour for rows of cosines and densities (CSV)");
     struct Opts {
         AtmosphereFlags atm;
+        ModelFlag model;
         std::string method = "tables", input, output;
         int steps = 16, shells = 256, cosines = 128;
         bool uniform = false, json = false;
     };
     auto o = std::make_shared<Opts>();
     o->atm.add(*sub);
+    o->model.add(*sub);
     sub->add_option("--method", o->method, "tables (the seed's sum over its tables, default) or exact");
     sub->add_option("--input", o->input, "CSV rows: cos_view_zenith,cos_view_sun,cos_sun_zenith,density")->required();
     sub->add_option("--output", o->output, "CSV rows r,g,b: radiance per unit sun irradiance, 1/sr")->required();
@@ -100,28 +102,34 @@ void add_sky_eval(CLI::App& group) {
     sub->add_option("--shells", o->shells, "Table rows n (default 256)");
     sub->add_option("--cosines", o->cosines, "Table columns m (default 128)");
     add_json_flag(*sub, o->json);
-    sub->callback([o] {
-        const SkyMethod method = parse_sky_method(o->method);
-        const Atmosphere atm = o->atm.load();
+    sub->callback([o, sub] {
+        const bool neural = o->model.active();
+        const NeuralSky net = neural ? o->model.load(*sub, o->atm) : NeuralSky{};
+        const SkyMethod method = neural ? SkyMethod::Tables : parse_sky_method(o->method);
+        const Atmosphere atm = neural ? net.atmosphere : o->atm.load();
         const std::vector<SkySample> samples = read_samples(o->input);
         SkyModelOptions opts;
         opts.steps = o->steps;
         opts.uniform_steps = o->uniform;
         opts.tables = {o->shells, o->cosines};
         const auto t0 = std::chrono::steady_clock::now();
-        const SkyModel model(atm, opts);
         std::vector<glm::vec3> out(samples.size());
-        evaluate_sky(model, samples, out, method);
+        if (neural)
+            evaluate_neural_sky(net, samples, out);
+        else
+            evaluate_sky(SkyModel(atm, opts), samples, out, method);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         write_stream_atomic(o->output, [&](std::ostream& f) {
             f << "r,g,b\n";
             for (const glm::vec3& c : out)
                 f << fmt::format("{:.9g},{:.9g},{:.9g}\n", c.x, c.y, c.z);
         });
-        info("{} samples, {} method, {:.3f} s -> {}", samples.size(), o->method, seconds, o->output);
+        const std::string method_name = neural ? "neural" : o->method;
+        info("{} samples, {} method, {:.3f} s -> {}", samples.size(), method_name, seconds, o->output);
         if (o->json)
             print_json({{"atmosphere", atm.name},
-                        {"method", o->method},
+                        {"method", method_name},
+                        {"model", o->model.path},
                         {"samples", samples.size()},
                         {"steps", o->steps},
                         {"seconds", seconds},

@@ -32,6 +32,7 @@ void add_sky_render(CLI::App& group) {
     auto* sub = group.add_subcommand("render", "Render the sky, the ground and the planet (PNG or EXR)");
     struct Opts {
         AtmosphereFlags atm;
+        ModelFlag model;
         SkyRenderSettings s;
         std::string view = "fisheye", size = "512x512", output, method = "tables", tone = "aces";
         double exposure = NAN;
@@ -41,6 +42,7 @@ void add_sky_render(CLI::App& group) {
     };
     auto o = std::make_shared<Opts>();
     o->atm.add(*sub);
+    o->model.add(*sub);
     sub->add_option("--altitude-km", o->s.altitude_km, "Observer altitude above the ground, km")->required();
     sub->add_option("--sun-elevation-deg", o->s.sun_elevation_deg, "Sun elevation above the observer's horizon")
         ->required();
@@ -58,8 +60,10 @@ void add_sky_render(CLI::App& group) {
     sub->add_flag("--no-sun", o->no_sun, "Do not draw the sun disc");
     sub->add_option("--ground", o->ground, "Ground model: lambert (physical, default) or seed (the seed's b-scaled term)");
     add_json_flag(*sub, o->json);
-    sub->callback([o] {
-        const Atmosphere atm = o->atm.load();
+    sub->callback([o, sub] {
+        const bool neural = o->model.active();
+        const NeuralSky net = neural ? o->model.load(*sub, o->atm) : NeuralSky{};
+        const Atmosphere atm = neural ? net.atmosphere : o->atm.load();
         if (o->view == "fisheye")
             o->s.view = SkyView::Fisheye;
         else if (o->view == "panorama")
@@ -69,7 +73,7 @@ void add_sky_render(CLI::App& group) {
         else
             throw Error("unknown view '" + o->view + "'; use fisheye, panorama or camera", "--view");
         parse_size(o->size, o->s.width, o->s.height, "--size");
-        o->s.method = parse_sky_method(o->method);
+        o->s.method = neural ? SkyMethod::Tables : parse_sky_method(o->method);
         o->s.sun_disc = !o->no_sun;
         if (o->ground != "lambert" && o->ground != "seed")
             throw Error("unknown ground model '" + o->ground + "'; use lambert or seed", "--ground");
@@ -82,8 +86,8 @@ void add_sky_render(CLI::App& group) {
         SkyModelOptions opts;
         opts.steps = o->steps;
         const auto t0 = std::chrono::steady_clock::now();
-        const SkyModel model(atm, opts);
-        const Image img = render_sky(model, o->s);
+        const SkyModel model = neural ? neural_reference_model(net) : SkyModel(atm, opts);
+        const Image img = neural ? render_neural_sky(net, model, o->s) : render_sky(model, o->s);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         tm.exposure_ev = std::isfinite(o->exposure) ? float(o->exposure) : float(auto_exposure(img));
         save_image(o->output, img, tm);
@@ -96,7 +100,8 @@ void add_sky_render(CLI::App& group) {
                         {"height", o->s.height},
                         {"altitude_km", o->s.altitude_km},
                         {"sun_elevation_deg", o->s.sun_elevation_deg},
-                        {"method", o->method},
+                        {"method", neural ? std::string("neural") : o->method},
+                        {"model", o->model.path},
                         {"ground", o->ground},
                         {"exposure_ev", tm.exposure_ev},
                         {"seconds", seconds},

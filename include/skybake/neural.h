@@ -1,0 +1,279 @@
+// skybake/neural.h: the neural sky of Pietras & Rudnicki (seed 000, sections
+// III and VI): small multi-layer perceptrons that approximate the sky function
+// I(cos α0, cos β0, cos θ0, ρ0) of skybake/sky.h, trained on the CPU, measured
+// against the sky model and exported as self-contained shader functions.
+//
+// [SECTION] Topology
+// [SECTION] Output encoding
+// [SECTION] The network and its weights file
+// [SECTION] Inference
+// [SECTION] Training
+// [SECTION] Learning curves
+// [SECTION] Export to shaders and C
+// [SECTION] Accuracy
+// [SECTION] Rendering
+//
+// See docs/neural.md for the maths, the measured errors and examples.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "skybake/image.h"
+#include "skybake/sky.h"
+
+namespace skybake {
+
+// [SECTION] Topology --------------------------------------------------------------
+//
+// Every network has 4 inputs (cos α0, cos β0, cos θ0, ρ0, as in SkySample) and
+// 4 encoded outputs (R, G, B, M; see the encoding below). Every neuron,
+// the outputs included, has a bias and the seed's activation
+//     f(x) = 1 / (1 + 2^(2x))        (values in (0, 1), f(0) = 0.5).
+//
+// independent (the seed): four sub-networks, one per output, each
+//     4 -> hidden[0] -> ... -> hidden[k-1] -> 1.
+// shared: one network 4 -> hidden[0] -> ... -> 4.
+// The seed's topology "paper" is independent with hidden = {8, 4}: 81 weights
+// per sub-network, 324 in total.
+struct NeuralTopology {
+    std::vector<int> hidden{8, 4}; // widths of the hidden layers: 1 to 7 layers, each 1 to 128 wide
+    bool shared = false;           // false: four independent sub-networks; true: one with four outputs
+
+    int subnet_count() const { return shared ? 1 : 4; }
+    int outputs_per_subnet() const { return shared ? 4 : 1; }
+    // Weights and biases of one sub-network, and of the whole network.
+    int subnet_weight_count() const;
+    int weight_count() const { return subnet_count() * subnet_weight_count(); }
+    // "paper", "independent:16x16", "shared:64x64".
+    std::string name() const;
+    // Throws skybake::Error naming `where` when a width or the depth is out of range.
+    void validate(const std::string& where = "topology") const;
+};
+
+// Parses "paper" (= independent:8x4), "independent:W1xW2x...", "shared:W1xW2x...".
+// Throws skybake::Error naming `where` for anything else.
+NeuralTopology parse_topology(std::string_view text, const std::string& where = "--topology");
+
+// [SECTION] Output encoding ---------------------------------------------------------
+//
+// The seed's normalisation (section III): with N = max(I_r, I_g, I_b),
+//   R = I_r/N, G = I_g/N, B = I_b/N       (chromaticity, the largest is 1)
+//   M = 0.9 N / max{N} + 0.05             (brightness; max{N} over 100,000 random samples)
+// and at night (N = 0) M = 0 with R, G, B not trained. The outputs of the
+// sigmoid-like activation lie in (0, 1), so every output is trained as
+// 0.05 + 0.9 · value; the seed's vertex program decodes all four outputs with
+// (x − 0.05)/0.9 and treats x < 0.05 as 0 (section VI, "final transformation").
+//
+// Brightness "seed" is the seed's linear M. Brightness "log" replaces it with
+//   M = 0.05 + 0.9 · max(0, 1 + ln(N / max{N}) / log_range),
+// so that a fixed error in M is a fixed *relative* error in N (the sky's
+// brightness spans many decades between noon and twilight).
+enum class BrightnessEncoding : int {
+    Seed = 0, // linear, as printed in the seed
+    Log = 1,  // logarithmic over log_range nats below max{N}
+};
+
+struct NeuralEncoding {
+    BrightnessEncoding brightness = BrightnessEncoding::Log;
+    double max_n = 1.0;      // max{N} over the max_n samples, radiance per unit sun irradiance (1/sr); > 0
+    double log_range = 13.815510557964274; // Log only: nats of N/max{N} mapped onto M in [0.05, 0.95] (ln 1e6)
+};
+
+// Encoded target (4 values in [0, 1]) of a radiance, and the radiance of 4
+// encoded outputs. Exposed for tests and for users who write their own decoder.
+void encode_sky_radiance(const NeuralEncoding& encoding, const glm::vec3& radiance, float encoded[4]);
+glm::vec3 decode_sky_radiance(const NeuralEncoding& encoding, const float encoded[4]);
+
+// [SECTION] The network and its weights file ------------------------------------------
+//
+// Weight layout (flat, float): sub-network s starts at s * subnet_weight_count();
+// inside it, for each layer l (inputs → hidden[0] → ... → outputs) the matrix
+// W_l, row-major [out][in], then the biases b_l [out]. A layer computes
+// a_out = f(W_l a_in + b_l). Sub-networks of the independent topology are in
+// the order R, G, B, M.
+struct NeuralTrainingSummary {
+    std::uint64_t samples = 0;         // training samples
+    std::uint64_t heldout_samples = 0; // held-out samples for the learning curve
+    std::uint64_t seed = 0;            // sampling and initialisation seed
+    int adam_epochs = 0;               // epochs of Adam
+    int lm_iterations = 0;             // Levenberg–Marquardt iterations run
+    double seconds = 0.0;              // wall-clock training time, data generation included
+    int threads = 0;                   // worker threads used
+    double train_rms = 0.0;            // RMS error of the encoded outputs, training set, at the end
+    double heldout_rms = 0.0;          // same, held-out set
+    double heldout_mean_relative = 0.0; // mean |ΔI|/|I| on the held-out samples with N > 0
+};
+
+// Settings of the sky model the network was trained on (SkyModelOptions).
+struct NeuralSky {
+    NeuralTopology topology;
+    NeuralEncoding encoding;
+    std::vector<float> weights;        // topology.weight_count() floats, layout above
+    Atmosphere atmosphere;             // the atmosphere it was trained on
+    SkyModelOptions sky_options;       // tables and steps of the training targets
+    NeuralTrainingSummary training;
+
+    // Throws skybake::Error naming `where` if the topology, the weight count,
+    // a weight or an encoding constant is invalid.
+    void validate(const std::string& where = "neural sky") const;
+};
+
+// JSON (format "skybake-neural-sky", version 1) <-> NeuralSky. Parsing
+// validates everything and throws skybake::Error naming `where` and the field.
+std::string neural_sky_to_json(const NeuralSky& net);
+NeuralSky neural_sky_from_json(std::string_view text, const std::string& where = "weights JSON");
+NeuralSky load_neural_sky(const std::filesystem::path& path);
+void save_neural_sky(const std::filesystem::path& path, const NeuralSky& net); // atomic write
+
+// The reference model the network approximates (its atmosphere and options).
+SkyModel neural_reference_model(const NeuralSky& net);
+
+// [SECTION] Inference ---------------------------------------------------------------
+//
+// Radiance per unit sun irradiance, 1/sr, as SkyModel::radiance. Samples must
+// be valid (is_valid_sky_sample; asserted). out.size() must equal samples.size().
+// Batch inference is vectorised (Eigen) and uses all cores; deterministic.
+void evaluate_neural_sky(const NeuralSky& net, std::span<const SkySample> samples, std::span<glm::vec3> out);
+// One sample through the scalar forward pass that shaders and CUDA share.
+glm::vec3 neural_sky_radiance(const NeuralSky& net, const SkySample& sample);
+// The 4 encoded outputs (R, G, B, M) of the scalar forward pass.
+void neural_sky_encoded(const NeuralSky& net, const SkySample& sample, float encoded[4]);
+
+// [SECTION] Training ------------------------------------------------------------------
+//
+// Samples are drawn uniformly over the valid part of [−1,1]³ × (0,1]
+// (draw_sky_samples: rejection of cosine triples with a negative Gram
+// determinant); targets come from SkyModel's table path (evaluate_sky).
+// Adam with an exponentially decaying learning rate on shuffled mini-batches,
+// then Levenberg–Marquardt on each sub-network. Deterministic for a given
+// seed, whatever the thread count.
+struct NeuralTrainOptions {
+    NeuralTopology topology;
+    BrightnessEncoding brightness = BrightnessEncoding::Log;
+    double log_range = 13.815510557964274;   // nats (Log only)
+    std::size_t samples = 800000;            // training samples
+    std::size_t heldout_samples = 20000;     // held-out samples for the learning curve
+    std::size_t max_n_samples = 100000;      // samples for max{N} (the seed's 100,000)
+    std::uint64_t seed = 1;
+    int adam_epochs = 40;
+    std::size_t batch = 1024;                // Adam mini-batch
+    double learning_rate = 0.02;             // Adam, first epoch
+    double learning_rate_final = 0.0005;     // Adam, last epoch (exponential decay between)
+    int lm_iterations = 30;                  // Levenberg–Marquardt iterations; 0 skips it
+    std::size_t lm_samples = 0;              // rows of the LM least squares; 0: automatic
+    bool progress = true;                    // progress bar on stderr (TTY only)
+};
+
+// One point of the learning curve: after Adam epoch `epoch` (phase "adam") or
+// after LM iteration `epoch − adam_epochs` (phase "lm").
+struct LearningCurvePoint {
+    int epoch = 0;
+    std::string phase;
+    double train_rms = 0.0;        // RMS error of the encoded outputs on the training set
+    double heldout_rms = 0.0;      // same on the held-out set
+    double heldout_mean_relative = 0.0; // mean |ΔI|/|I| on held-out samples with N > 0
+    double seconds = 0.0;          // since training started
+};
+
+NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& options,
+                           std::vector<LearningCurvePoint>* curve = nullptr);
+
+// [SECTION] Learning curves ------------------------------------------------------------
+// CSV: epoch,phase,train_rms,heldout_rms,heldout_mean_relative,seconds.
+void save_learning_curve_csv(const std::filesystem::path& path, const std::vector<LearningCurvePoint>& curve);
+// One labelled curve on a chart.
+struct ChartSeries {
+    std::string label;
+    glm::vec3 colour{0.0f};      // linear RGB in [0, 1]
+    std::vector<double> x, y;    // y > 0 (log scale); equal sizes
+};
+// A line chart with a logarithmic y axis, ticks and labels drawn with a
+// built-in 5x7 font; linear RGB in [0, 1] (save with ToneCurve::Clamp).
+Image draw_line_chart(const std::vector<ChartSeries>& series, const std::string& title, const std::string& x_label,
+                      const std::string& y_label, int width = 800, int height = 500);
+// Training and held-out RMS against epoch, as PNG.
+void save_learning_curve_png(const std::filesystem::path& path, const std::vector<LearningCurvePoint>& curve,
+                             const std::string& title);
+
+// [SECTION] Export to shaders and C -------------------------------------------------------
+//
+// A self-contained function with the weights baked in as constants:
+//   GLSL: vec3   NAME(float cos_view_zenith, float cos_view_sun, float cos_sun_zenith, float density)
+//   HLSL: float3 NAME(...)
+//   CUDA: __host__ __device__ void NAME(..., float rgb[3])  (also plain C++ without nvcc)
+//   C:    void NAME(..., float rgb[3])                       (C99, needs <math.h>)
+// It returns radiance per unit sun irradiance (1/sr); it works in vertex and
+// fragment shaders (no uniforms, no textures). All arithmetic is float.
+enum class ExportLanguage : int { Glsl = 0, Hlsl = 1, Cuda = 2, C = 3 };
+ExportLanguage parse_export_language(std::string_view text, const std::string& where = "--format");
+std::string export_neural_sky(const NeuralSky& net, ExportLanguage language,
+                              const std::string& function_name = "skybake_sky");
+
+// [SECTION] Accuracy -------------------------------------------------------------------------
+//
+// Relative RGB error |ΔI|/|I| (Euclidean norms over R, G, B) on held-out
+// valid samples, split by the reference radiance:
+//   day:      the sun above the observer's horizon (cos θ0 > 0) and N > 0,
+//   twilight: the sun below it (cos θ0 ≤ 0) and N > 0,
+//   night:    N = 0 (the whole view ray in the planet's shadow); relative
+//             error is undefined there, so the absolute error |ΔI| / max{N} is reported.
+struct ErrorStats {
+    std::size_t count = 0;
+    double mean = 0.0, p50 = 0.0, p95 = 0.0, p99 = 0.0, max = 0.0;
+};
+// Statistics of a list of errors (sorted in place).
+ErrorStats error_stats(std::vector<double>& errors);
+
+struct ViewPsnr {
+    std::string name;
+    double psnr_db = 0.0; // of the tone-mapped sRGB image against the reference's
+};
+
+struct NeuralErrorReport {
+    ErrorStats all, day, twilight; // relative errors
+    ErrorStats night;              // |ΔI| / max{N}
+    std::vector<ViewPsnr> views;
+    double mean_view_psnr_db = 0.0;
+    double min_view_psnr_db = 0.0;
+};
+
+struct NeuralErrorOptions {
+    std::size_t samples = 100000;
+    std::uint64_t seed = 0x5eed000e77;  // distinct from the training streams
+    bool views = true;                  // render the seed's views and compare
+    int view_width = 240, view_height = 160;
+    std::filesystem::path views_dir;    // when not empty: write NAME_reference.png and NAME_neural.png there
+};
+
+NeuralErrorReport measure_neural_sky_error(const NeuralSky& net, const NeuralErrorOptions& options = {});
+
+// [SECTION] Rendering --------------------------------------------------------------------------
+//
+// The seed's views (section VII): sea level, higher and higher, low sun, very
+// high. Camera views; the atmosphere is the network's.
+struct SeedView {
+    std::string name;
+    SkyRenderSettings settings;
+};
+std::vector<SeedView> seed_views(int width, int height);
+
+// As render_sky, with the sky and the in-scattered light in front of the ground
+// from the network (the seed's section III), and the ground and the sun disc
+// from the tables of `tables` (section IV; build it with neural_reference_model).
+// settings.method is ignored.
+Image render_neural_sky(const NeuralSky& net, const SkyModel& tables, const SkyRenderSettings& settings);
+
+// Exposure (stops) that maps the 98th percentile of luminance to 1 (as `sky render`).
+double auto_exposure_ev(const Image& image);
+// PSNR in dB of two images of the same size after tone mapping both with tm
+// and the sRGB transfer function (display values in [0, 1], not quantised).
+double image_psnr_db(const Image& reference, const Image& test, const ToneMap& tm);
+
+} // namespace skybake

@@ -1,0 +1,91 @@
+// Accuracy of a neural sky against the sky model it approximates (Pietras &
+// Rudnicki, seed 000, sections III and VII): relative RGB error on held-out
+// random samples, split into day, twilight and night, and the PSNR of the
+// seed's views rendered with the network against the same views from the
+// model's marching sum.
+#include <algorithm>
+#include <cmath>
+
+#include <glm/geometric.hpp>
+
+#include "neural/internal.h"
+#include "skybake/error.h"
+
+namespace skybake {
+
+ErrorStats error_stats(std::vector<double>& e) {
+    ErrorStats s;
+    s.count = e.size();
+    if (e.empty())
+        return s;
+    std::sort(e.begin(), e.end());
+    double sum = 0.0;
+    for (double v : e)
+        sum += v;
+    s.mean = sum / double(e.size());
+    auto pct = [&](double p) { // nearest rank
+        const std::size_t k = std::size_t(std::ceil(p * double(e.size())));
+        return e[std::min(e.size() - 1, k == 0 ? 0 : k - 1)];
+    };
+    s.p50 = pct(0.50);
+    s.p95 = pct(0.95);
+    s.p99 = pct(0.99);
+    s.max = e.back();
+    return s;
+}
+
+NeuralErrorReport measure_neural_sky_error(const NeuralSky& net, const NeuralErrorOptions& o) {
+    net.validate("neural sky");
+    if (o.samples < 1 || o.samples > (std::size_t(1) << 28))
+        throw Error("the number of samples must be 1 to 2^28", "--samples");
+    if (o.views && (o.view_width < 1 || o.view_height < 1 || o.view_width > 4096 || o.view_height > 4096))
+        throw Error("view size must be 1 to 4096 pixels on each side", "--size");
+    const SkyModel model = neural_reference_model(net);
+    const std::vector<SkySample> samples = draw_sky_samples(o.samples, o.seed);
+    std::vector<glm::vec3> ref(samples.size()), got(samples.size());
+    evaluate_sky(model, samples, ref, SkyMethod::Tables);
+    evaluate_neural_sky(net, samples, got);
+
+    std::vector<double> all, day, twilight, night;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+        const glm::dvec3 r(ref[i]), g(got[i]);
+        const double err = glm::length(g - r);
+        if (!(std::max({r.x, r.y, r.z}) > 0.0)) {
+            night.push_back(err / net.encoding.max_n);
+            continue;
+        }
+        const double rel = err / glm::length(r);
+        all.push_back(rel);
+        (samples[i].cos_sun_zenith > 0.0f ? day : twilight).push_back(rel);
+    }
+    NeuralErrorReport rep;
+    rep.all = error_stats(all);
+    rep.day = error_stats(day);
+    rep.twilight = error_stats(twilight);
+    rep.night = error_stats(night);
+
+    if (o.views) {
+        if (!o.views_dir.empty())
+            std::filesystem::create_directories(o.views_dir);
+        double sum = 0.0, mn = INFINITY;
+        for (const SeedView& v : seed_views(o.view_width, o.view_height)) {
+            const Image a = render_sky(model, v.settings);
+            const Image b = render_neural_sky(net, model, v.settings);
+            ToneMap tm;
+            tm.exposure_ev = float(auto_exposure_ev(a));
+            const double psnr = image_psnr_db(a, b, tm);
+            rep.views.push_back({v.name, psnr});
+            sum += psnr;
+            mn = std::min(mn, psnr);
+            if (!o.views_dir.empty()) {
+                save_image(o.views_dir / (v.name + "_reference.png"), a, tm);
+                save_image(o.views_dir / (v.name + "_neural.png"), b, tm);
+            }
+        }
+        rep.mean_view_psnr_db = sum / double(rep.views.size());
+        rep.min_view_psnr_db = mn;
+    }
+    return rep;
+}
+
+} // namespace skybake

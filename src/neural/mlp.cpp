@@ -1,0 +1,263 @@
+// Batched forward and backward passes of the seed's perceptron (Pietras &
+// Rudnicki, seed 000, section III) with Eigen: one sample per column, one
+// matrix product per layer, the activation f(x) = 1/(1 + 2^(2x)) vectorised.
+// Also the output encoding of section III and the CPU batch inference.
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include "core/parallel.h"
+#include "neural/internal.h"
+
+namespace skybake {
+
+using namespace neural;
+
+namespace neural {
+
+namespace {
+
+using RowMap = Eigen::Map<const Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
+
+// a = f(W in + b), in place over z.
+void layer_forward(const LayerLayout& L, const float* w, const Eigen::Ref<const MatF>& in, MatF& a) {
+    const RowMap W(w + L.w_offset, L.out, L.in);
+    const Eigen::Map<const Eigen::VectorXf> b(w + L.b_offset, L.out);
+    a.resize(L.out, in.cols());
+    a.noalias() = W * in;
+    a.colwise() += b;
+    a = (1.0f + (a.array() * kSlope).exp()).inverse().matrix();
+}
+
+// f'(z) expressed by the output a = f(z): −kSlope a (1 − a).
+auto activation_slope(const MatF& a) { return (-kSlope) * a.array() * (1.0f - a.array()); }
+
+} // namespace
+
+Layout make_layout(const NeuralTopology& topology) {
+    Layout lay;
+    lay.subnets = topology.subnet_count();
+    lay.outputs = topology.outputs_per_subnet();
+    std::vector<int> widths{kInputs};
+    widths.insert(widths.end(), topology.hidden.begin(), topology.hidden.end());
+    widths.push_back(lay.outputs);
+    int off = 0;
+    for (std::size_t l = 0; l + 1 < widths.size(); ++l) {
+        LayerLayout L;
+        L.in = widths[l];
+        L.out = widths[l + 1];
+        L.w_offset = off;
+        off += L.in * L.out;
+        L.b_offset = off;
+        off += L.out;
+        lay.layers.push_back(L);
+    }
+    lay.subnet_params = off;
+    return lay;
+}
+
+MlpHD make_mlp_hd(const NeuralSky& net) {
+    const Layout lay = make_layout(net.topology);
+    assert(int(lay.layers.size()) <= kMaxLayers);
+    MlpHD m;
+    m.weights = net.weights.data();
+    m.subnets = lay.subnets;
+    m.layers = int(lay.layers.size());
+    m.width[0] = kInputs;
+    for (int l = 0; l < m.layers; ++l)
+        m.width[l + 1] = lay.layers[std::size_t(l)].out;
+    m.subnet_params = lay.subnet_params;
+    m.brightness = net.encoding.brightness == BrightnessEncoding::Seed ? kBrightnessSeed : kBrightnessLog;
+    m.max_n = float(net.encoding.max_n);
+    m.log_range = float(net.encoding.log_range);
+    return m;
+}
+
+void forward_subnet(const Layout& layout, const float* w, const Eigen::Ref<const MatF>& x, Workspace& ws) {
+    ws.a.resize(layout.layers.size());
+    for (std::size_t l = 0; l < layout.layers.size(); ++l) {
+        if (l == 0)
+            layer_forward(layout.layers[l], w, x, ws.a[l]);
+        else
+            layer_forward(layout.layers[l], w, ws.a[l - 1], ws.a[l]);
+    }
+}
+
+void forward_network(const Layout& layout, const float* weights, const Eigen::Ref<const MatF>& x,
+                     Eigen::Ref<MatF> out, Workspace& ws) {
+    for (int s = 0; s < layout.subnets; ++s) {
+        forward_subnet(layout, weights + std::size_t(s) * std::size_t(layout.subnet_params), x, ws);
+        out.middleRows(s * layout.outputs, layout.outputs) = ws.a.back();
+    }
+}
+
+double subnet_loss_grad(const Layout& layout, const float* weights, int s, const Eigen::Ref<const MatF>& x,
+                        const Eigen::Ref<const MatF>& t, const Eigen::Ref<const MatF>& mask, double* grad,
+                        Workspace& ws) {
+    const float* w = weights + std::size_t(s) * std::size_t(layout.subnet_params);
+    forward_subnet(layout, w, x, ws);
+    const int nl = int(layout.layers.size());
+    const int row = s * layout.outputs;
+    const MatF& y = ws.a.back();
+    ws.delta.resize(std::size_t(nl));
+    MatF& d_out = ws.delta[std::size_t(nl - 1)];
+    d_out = (mask.middleRows(row, layout.outputs).array() * (y.array() - t.middleRows(row, layout.outputs).array()))
+                .matrix();
+    const double loss = double(d_out.squaredNorm());
+    if (!grad)
+        return loss;
+    d_out.array() *= activation_slope(y);
+    for (int l = nl - 1; l >= 0; --l) {
+        const LayerLayout& L = layout.layers[std::size_t(l)];
+        const MatF& d = ws.delta[std::size_t(l)];
+        const Eigen::Ref<const MatF> in = l == 0 ? x : Eigen::Ref<const MatF>(ws.a[std::size_t(l - 1)]);
+        const MatF g = d * in.transpose(); // out × in
+        for (int r = 0; r < L.out; ++r)
+            for (int c = 0; c < L.in; ++c)
+                grad[L.w_offset + r * L.in + c] += double(g(r, c));
+        const Eigen::VectorXf gb = d.rowwise().sum();
+        for (int r = 0; r < L.out; ++r)
+            grad[L.b_offset + r] += double(gb(r));
+        if (l > 0) {
+            const RowMap W(w + L.w_offset, L.out, L.in);
+            MatF& dp = ws.delta[std::size_t(l - 1)];
+            dp.noalias() = W.transpose() * d;
+            dp.array() *= activation_slope(ws.a[std::size_t(l - 1)]);
+        }
+    }
+    return loss;
+}
+
+double subnet_normal_equations(const Layout& layout, const float* weights, int s, const Eigen::Ref<const MatF>& x,
+                               const Eigen::Ref<const MatF>& t, const Eigen::Ref<const MatF>& mask,
+                               Eigen::MatrixXf& jtj, Eigen::VectorXf& jtr, Workspace& ws) {
+    const float* w = weights + std::size_t(s) * std::size_t(layout.subnet_params);
+    forward_subnet(layout, w, x, ws);
+    const int nl = int(layout.layers.size());
+    const Eigen::Index B = x.cols();
+    const int P = layout.subnet_params;
+    const MatF& y = ws.a.back();
+    const MatF slope_out = activation_slope(y).matrix();
+    ws.delta.resize(std::size_t(nl));
+    MatF J(B, P);
+    double loss = 0.0;
+    for (int o = 0; o < layout.outputs; ++o) {
+        const int row = s * layout.outputs + o;
+        const Eigen::VectorXf m = mask.row(row).transpose();
+        const Eigen::VectorXf r = (m.array() * (y.row(o).transpose().array() - t.row(row).transpose().array())).matrix();
+        loss += double(r.squaredNorm());
+        MatF& d_out = ws.delta[std::size_t(nl - 1)];
+        d_out.setZero(layout.outputs, B);
+        d_out.row(o) = (m.transpose().array() * slope_out.row(o).array()).matrix();
+        for (int l = nl - 1; l >= 0; --l) {
+            const LayerLayout& L = layout.layers[std::size_t(l)];
+            const MatF& d = ws.delta[std::size_t(l)];
+            const Eigen::Ref<const MatF> in = l == 0 ? x : Eigen::Ref<const MatF>(ws.a[std::size_t(l - 1)]);
+            for (int rr = 0; rr < L.out; ++rr) {
+                for (int c = 0; c < L.in; ++c)
+                    J.col(L.w_offset + rr * L.in + c) = (d.row(rr).array() * in.row(c).array()).transpose();
+                J.col(L.b_offset + rr) = d.row(rr).transpose();
+            }
+            if (l > 0) {
+                const RowMap W(w + L.w_offset, L.out, L.in);
+                MatF& dp = ws.delta[std::size_t(l - 1)];
+                dp.noalias() = W.transpose() * d;
+                dp.array() *= activation_slope(ws.a[std::size_t(l - 1)]);
+            }
+        }
+        jtj.selfadjointView<Eigen::Lower>().rankUpdate(J.transpose());
+        jtr.noalias() += J.transpose() * r;
+    }
+    return loss;
+}
+
+void encode_targets(const NeuralEncoding& encoding, std::span<const glm::vec3> radiance, MatF& targets, MatF& mask) {
+    const Eigen::Index n = Eigen::Index(radiance.size());
+    targets.resize(4, n);
+    mask.resize(4, n);
+    parallel_for(radiance.size(), 4096, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+            float enc[4];
+            encode_sky_radiance(encoding, radiance[i], enc);
+            const bool night = !(std::max({radiance[i].x, radiance[i].y, radiance[i].z}) > 0.0f);
+            for (int k = 0; k < 4; ++k) {
+                targets(k, Eigen::Index(i)) = enc[k];
+                mask(k, Eigen::Index(i)) = night && k < 3 ? 0.0f : 1.0f;
+            }
+        }
+    });
+}
+
+MatF samples_to_matrix(std::span<const SkySample> samples) {
+    MatF x(4, Eigen::Index(samples.size()));
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+        x(0, Eigen::Index(i)) = samples[i].cos_view_zenith;
+        x(1, Eigen::Index(i)) = samples[i].cos_view_sun;
+        x(2, Eigen::Index(i)) = samples[i].cos_sun_zenith;
+        x(3, Eigen::Index(i)) = samples[i].density;
+    }
+    return x;
+}
+
+} // namespace neural
+
+void encode_sky_radiance(const NeuralEncoding& e, const glm::vec3& c, float enc[4]) {
+    const float n = std::max({c.x, c.y, c.z});
+    if (!(n > 0.0f)) { // night: M = 0; R, G, B are not trained (mask)
+        enc[0] = enc[1] = enc[2] = enc[3] = 0.0f;
+        return;
+    }
+    enc[0] = kEncodeOffset + kEncodeScale * std::max(0.0f, c.x) / n;
+    enc[1] = kEncodeOffset + kEncodeScale * std::max(0.0f, c.y) / n;
+    enc[2] = kEncodeOffset + kEncodeScale * std::max(0.0f, c.z) / n;
+    double m;
+    if (e.brightness == BrightnessEncoding::Seed)
+        m = double(n) / e.max_n;
+    else
+        m = std::max(0.0, 1.0 + std::log(double(n) / e.max_n) / e.log_range);
+    enc[3] = float(kEncodeOffset + kEncodeScale * std::min(m, 1.0));
+}
+
+glm::vec3 decode_sky_radiance(const NeuralEncoding& e, const float enc[4]) {
+    MlpHD m;
+    m.brightness = e.brightness == BrightnessEncoding::Seed ? kBrightnessSeed : kBrightnessLog;
+    m.max_n = float(e.max_n);
+    m.log_range = float(e.log_range);
+    return decode_sky(m, enc);
+}
+
+void evaluate_neural_sky(const NeuralSky& net, std::span<const SkySample> samples, std::span<glm::vec3> out) {
+    assert(samples.size() == out.size());
+    assert(net.weights.size() == std::size_t(net.topology.weight_count()));
+    const Layout layout = make_layout(net.topology);
+    const MlpHD hd = make_mlp_hd(net);
+    constexpr std::size_t kBlock = 1024;
+    const std::size_t blocks = (samples.size() + kBlock - 1) / kBlock;
+    parallel_for(blocks, 1, [&](std::size_t b0, std::size_t b1) {
+        Workspace ws;
+        MatF enc(4, Eigen::Index(kBlock));
+        for (std::size_t b = b0; b < b1; ++b) {
+            const std::size_t lo = b * kBlock, hi = std::min(samples.size(), lo + kBlock);
+            const MatF x = samples_to_matrix(samples.subspan(lo, hi - lo));
+            enc.resize(4, x.cols());
+            forward_network(layout, net.weights.data(), x, enc, ws);
+            for (std::size_t i = lo; i < hi; ++i) {
+                assert(is_valid_sky_sample(samples[i], 1e-4));
+                out[i] = decode_sky(hd, enc.col(Eigen::Index(i - lo)).data());
+            }
+        }
+    });
+}
+
+glm::vec3 neural_sky_radiance(const NeuralSky& net, const SkySample& s) {
+    const MlpHD hd = make_mlp_hd(net);
+    return neural_sky(hd, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density);
+}
+
+void neural_sky_encoded(const NeuralSky& net, const SkySample& s, float enc[4]) {
+    const MlpHD hd = make_mlp_hd(net);
+    const float in[4] = {s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density};
+    mlp_forward(hd, in, enc);
+}
+
+} // namespace skybake

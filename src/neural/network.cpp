@@ -1,0 +1,268 @@
+// Topologies and the weights file of the neural sky (Pietras & Rudnicki,
+// seed 000, section III: four independent 4 -> 8 -> 4 -> 1 sub-networks, 324
+// weights, and the general widths/depths built on the same layout).
+#include <charconv>
+#include <cmath>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "neural/internal.h"
+#include "skybake/error.h"
+#include "skybake/files.h"
+
+namespace skybake {
+
+using json = nlohmann::json;
+
+namespace {
+
+constexpr const char* kFormat = "skybake-neural-sky";
+constexpr int kVersion = 1;
+
+} // namespace
+
+int NeuralTopology::subnet_weight_count() const {
+    int in = neural::kInputs, n = 0;
+    for (int w : hidden) {
+        n += (in + 1) * w;
+        in = w;
+    }
+    return n + (in + 1) * outputs_per_subnet();
+}
+
+std::string NeuralTopology::name() const {
+    if (!shared && hidden == std::vector<int>{8, 4})
+        return "paper";
+    std::string s = shared ? "shared:" : "independent:";
+    for (std::size_t i = 0; i < hidden.size(); ++i)
+        s += (i ? "x" : "") + std::to_string(hidden[i]);
+    return s;
+}
+
+void NeuralTopology::validate(const std::string& where) const {
+    if (hidden.empty() || int(hidden.size()) > neural::kMaxHidden)
+        throw Error(fmt::format("a network needs 1 to {} hidden layers, got {}", neural::kMaxHidden, hidden.size()),
+                    where);
+    for (int w : hidden)
+        if (w < 1 || w > neural::kMaxWidth)
+            throw Error(fmt::format("hidden layer width {} is outside 1..{}", w, neural::kMaxWidth), where);
+}
+
+NeuralTopology parse_topology(std::string_view text, const std::string& where) {
+    const std::string usage = "use paper, independent:W1xW2... or shared:W1xW2... (e.g. independent:16x16)";
+    NeuralTopology t;
+    if (text == "paper")
+        return t;
+    const std::size_t colon = text.find(':');
+    if (colon == std::string_view::npos)
+        throw Error(fmt::format("unknown topology '{}'; {}", text, usage), where);
+    const std::string_view kind = text.substr(0, colon);
+    if (kind == "shared")
+        t.shared = true;
+    else if (kind != "independent")
+        throw Error(fmt::format("unknown topology kind '{}'; {}", kind, usage), where);
+    t.hidden.clear();
+    std::string_view rest = text.substr(colon + 1);
+    for (;;) {
+        const std::size_t x = rest.find('x');
+        const std::string_view part = rest.substr(0, x);
+        int w = 0;
+        const auto r = std::from_chars(part.data(), part.data() + part.size(), w);
+        if (part.empty() || r.ec != std::errc() || r.ptr != part.data() + part.size())
+            throw Error(fmt::format("bad layer width '{}' in topology '{}'; {}", part, text, usage), where);
+        t.hidden.push_back(w);
+        if (x == std::string_view::npos)
+            break;
+        rest = rest.substr(x + 1);
+    }
+    t.validate(where);
+    return t;
+}
+
+void NeuralSky::validate(const std::string& where) const {
+    topology.validate(where + ": topology");
+    if (weights.size() != std::size_t(topology.weight_count()))
+        throw Error(fmt::format("topology {} needs {} weights but the file has {}; the file is corrupt or was edited, "
+                                "train it again with `skybake sky train`",
+                                topology.name(), topology.weight_count(), weights.size()),
+                    where);
+    for (std::size_t i = 0; i < weights.size(); ++i)
+        if (!std::isfinite(weights[i]))
+            throw Error(fmt::format("weight {} is not a finite number; train the network again", i), where);
+    if (!(std::isfinite(encoding.max_n) && encoding.max_n > 0.0))
+        throw Error("encoding.max_n must be a positive number", where);
+    if (encoding.brightness == BrightnessEncoding::Log &&
+        !(std::isfinite(encoding.log_range) && encoding.log_range > 0.0 && encoding.log_range < 200.0))
+        throw Error("encoding.log_range must be in (0, 200) nats", where);
+}
+
+std::string neural_sky_to_json(const NeuralSky& net) {
+    json j;
+    j["format"] = kFormat;
+    j["version"] = kVersion;
+    j["topology"] = {{"name", net.topology.name()},
+                     {"kind", net.topology.shared ? "shared" : "independent"},
+                     {"hidden", net.topology.hidden},
+                     {"inputs", "cos_view_zenith, cos_view_sun, cos_sun_zenith, density"},
+                     {"outputs", "R/N, G/N, B/N, M (each as 0.05 + 0.9 value)"},
+                     {"activation", "1/(1+2^(2x))"},
+                     {"weight_count", net.topology.weight_count()}};
+    j["encoding"] = {{"brightness", net.encoding.brightness == BrightnessEncoding::Seed ? "seed" : "log"},
+                     {"max_n", net.encoding.max_n},
+                     {"log_range", net.encoding.log_range}};
+    json subnets = json::array();
+    const std::size_t per = std::size_t(net.topology.subnet_weight_count());
+    for (int s = 0; s < net.topology.subnet_count(); ++s) {
+        json w = json::array();
+        for (std::size_t i = 0; i < per; ++i)
+            w.push_back(double(net.weights[std::size_t(s) * per + i]));
+        subnets.push_back(std::move(w));
+    }
+    j["weights"] = std::move(subnets);
+    j["weights_layout"] = "per sub-network (R, G, B, M; or one shared), per layer: W row-major [out][in], then b [out]";
+    j["atmosphere"] = json::parse(atmosphere_to_json(net.atmosphere));
+    j["sky_model"] = {{"steps", net.sky_options.steps},
+                      {"uniform_steps", net.sky_options.uniform_steps},
+                      {"shells", net.sky_options.tables.shells},
+                      {"cosines", net.sky_options.tables.cosines}};
+    const NeuralTrainingSummary& t = net.training;
+    j["training"] = {{"samples", t.samples},
+                     {"heldout_samples", t.heldout_samples},
+                     {"seed", t.seed},
+                     {"adam_epochs", t.adam_epochs},
+                     {"lm_iterations", t.lm_iterations},
+                     {"seconds", t.seconds},
+                     {"threads", t.threads},
+                     {"train_rms", t.train_rms},
+                     {"heldout_rms", t.heldout_rms},
+                     {"heldout_mean_relative", t.heldout_mean_relative}};
+    return j.dump(1) + "\n";
+}
+
+namespace {
+
+const json& field(const json& j, const char* name, const std::string& where) {
+    if (!j.is_object() || !j.contains(name))
+        throw Error(fmt::format("missing field '{}'; is this a weights file written by `skybake sky train`?", name),
+                    where);
+    return j.at(name);
+}
+
+double number(const json& j, const char* name, const std::string& where) {
+    const json& v = field(j, name, where);
+    if (!v.is_number())
+        throw Error(fmt::format("field '{}' must be a number", name), where);
+    return v.get<double>();
+}
+
+int integer(const json& j, const char* name, const std::string& where, int lo, int hi) {
+    const json& v = field(j, name, where);
+    if (!v.is_number_integer() || v.get<long long>() < lo || v.get<long long>() > hi)
+        throw Error(fmt::format("field '{}' must be an integer in {}..{}", name, lo, hi), where);
+    return v.get<int>();
+}
+
+} // namespace
+
+NeuralSky neural_sky_from_json(std::string_view text, const std::string& where) {
+    json j;
+    try {
+        j = json::parse(text);
+    } catch (const json::exception& e) {
+        throw Error(fmt::format("not valid JSON ({}); the weights file is corrupt", e.what()), where);
+    }
+    if (!j.is_object() || !j.contains("format") || j["format"] != kFormat)
+        throw Error(fmt::format("not a neural sky weights file (expected \"format\": \"{}\")", kFormat), where);
+    if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<int>() != kVersion)
+        throw Error(fmt::format("unsupported weights file version (this build reads version {})", kVersion), where);
+    NeuralSky net;
+    try {
+        const json& top = field(j, "topology", where);
+        const json& kind = field(top, "kind", where + ": topology");
+        if (kind != "independent" && kind != "shared")
+            throw Error("topology.kind must be \"independent\" or \"shared\"", where);
+        net.topology.shared = kind == "shared";
+        const json& hidden = field(top, "hidden", where + ": topology");
+        if (!hidden.is_array())
+            throw Error("topology.hidden must be an array of layer widths", where);
+        net.topology.hidden.clear();
+        for (const json& w : hidden) {
+            if (!w.is_number_integer())
+                throw Error("topology.hidden must hold integers", where);
+            net.topology.hidden.push_back(w.get<int>());
+        }
+        net.topology.validate(where + ": topology");
+
+        const json& enc = field(j, "encoding", where);
+        const json& b = field(enc, "brightness", where + ": encoding");
+        if (b == "seed")
+            net.encoding.brightness = BrightnessEncoding::Seed;
+        else if (b == "log")
+            net.encoding.brightness = BrightnessEncoding::Log;
+        else
+            throw Error("encoding.brightness must be \"seed\" or \"log\"", where);
+        net.encoding.max_n = number(enc, "max_n", where + ": encoding");
+        net.encoding.log_range = number(enc, "log_range", where + ": encoding");
+
+        const json& w = field(j, "weights", where);
+        if (!w.is_array() || int(w.size()) != net.topology.subnet_count())
+            throw Error(fmt::format("'weights' must hold {} sub-network arrays for topology {}",
+                                    net.topology.subnet_count(), net.topology.name()),
+                        where);
+        for (std::size_t s = 0; s < w.size(); ++s) {
+            if (!w[s].is_array() || int(w[s].size()) != net.topology.subnet_weight_count())
+                throw Error(fmt::format("sub-network {} must have {} weights for topology {}, has {}; the file is "
+                                        "corrupt or does not match its topology",
+                                        s, net.topology.subnet_weight_count(), net.topology.name(),
+                                        w[s].is_array() ? w[s].size() : 0),
+                            where);
+            for (const json& v : w[s]) {
+                if (!v.is_number())
+                    throw Error(fmt::format("sub-network {} holds a weight that is not a number", s), where);
+                net.weights.push_back(float(v.get<double>()));
+            }
+        }
+        net.atmosphere = atmosphere_from_json(field(j, "atmosphere", where).dump(), where + ": atmosphere");
+        const json& sm = field(j, "sky_model", where);
+        net.sky_options.steps = integer(sm, "steps", where + ": sky_model", 1, 1 << 20);
+        net.sky_options.tables.shells = integer(sm, "shells", where + ": sky_model", 2, 1 << 14);
+        net.sky_options.tables.cosines = integer(sm, "cosines", where + ": sky_model", 2, 1 << 14);
+        const json& us = field(sm, "uniform_steps", where + ": sky_model");
+        if (!us.is_boolean())
+            throw Error("sky_model.uniform_steps must be true or false", where);
+        net.sky_options.uniform_steps = us.get<bool>();
+        if (j.contains("training") && j["training"].is_object()) {
+            const json& t = j["training"];
+            NeuralTrainingSummary& s = net.training;
+            s.samples = t.value("samples", std::uint64_t(0));
+            s.heldout_samples = t.value("heldout_samples", std::uint64_t(0));
+            s.seed = t.value("seed", std::uint64_t(0));
+            s.adam_epochs = t.value("adam_epochs", 0);
+            s.lm_iterations = t.value("lm_iterations", 0);
+            s.seconds = t.value("seconds", 0.0);
+            s.threads = t.value("threads", 0);
+            s.train_rms = t.value("train_rms", 0.0);
+            s.heldout_rms = t.value("heldout_rms", 0.0);
+            s.heldout_mean_relative = t.value("heldout_mean_relative", 0.0);
+        }
+    } catch (const json::exception& e) {
+        throw Error(fmt::format("malformed weights file ({})", e.what()), where);
+    }
+    net.validate(where);
+    return net;
+}
+
+NeuralSky load_neural_sky(const std::filesystem::path& path) {
+    return neural_sky_from_json(read_file(path, std::uint64_t(1) << 28), path.string());
+}
+
+void save_neural_sky(const std::filesystem::path& path, const NeuralSky& net) {
+    net.validate("neural sky");
+    const std::string text = neural_sky_to_json(net);
+    write_stream_atomic(path, [&](std::ostream& out) { out << text; });
+}
+
+SkyModel neural_reference_model(const NeuralSky& net) { return SkyModel(net.atmosphere, net.sky_options); }
+
+} // namespace skybake

@@ -1,0 +1,373 @@
+// Training of the neural sky on the CPU (Pietras & Rudnicki, seed 000,
+// section III: random uniform samples of the sky function, 800,000 of them).
+//
+// Kingma D. P., Ba J. Adam: A Method for Stochastic Optimization. ICLR 2015.
+// Marquardt D. W. An Algorithm for Least-Squares Estimation of Nonlinear
+// Parameters. SIAM J. Appl. Math. 11(2), 1963.
+//
+// Adam on shuffled mini-batches with an exponentially decaying step, then
+// Levenberg–Marquardt on each sub-network: the sub-networks of the seed's
+// topology are independent (81 parameters each), so their normal equations
+// are small and dense. Every reduction is cut into fixed chunks and summed in
+// chunk order, so the result does not depend on the thread count.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+
+#include <Eigen/Cholesky>
+#include <fmt/format.h>
+
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "neural/internal.h"
+#include "skybake/core.h"
+#include "skybake/error.h"
+
+namespace skybake {
+
+using namespace neural;
+
+namespace {
+
+// SplitMix64 (Steele, Lea, Flood 2014).
+struct SplitMix {
+    std::uint64_t state;
+    std::uint64_t next() {
+        std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        return z ^ (z >> 31);
+    }
+    double uniform() { return double(next() >> 11) * 0x1.0p-53; } // [0, 1)
+};
+
+std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t stream) {
+    SplitMix r{seed ^ (stream * 0xA0761D6478BD642Full)};
+    r.next();
+    return r.next();
+}
+
+// Training or held-out data: inputs, encoded targets, masks, and the reference radiance.
+struct DataSet {
+    MatF x, t, mask;
+    std::vector<glm::vec3> radiance;
+    double mask_count = 0.0;
+    std::size_t size() const { return radiance.size(); }
+};
+
+DataSet make_data(const SkyModel& model, const NeuralEncoding& enc, std::size_t n, std::uint64_t seed) {
+    DataSet d;
+    const std::vector<SkySample> s = draw_sky_samples(n, seed);
+    d.radiance.resize(n);
+    evaluate_sky(model, s, d.radiance, SkyMethod::Tables);
+    d.x = samples_to_matrix(s);
+    encode_targets(enc, d.radiance, d.t, d.mask);
+    d.mask_count = double(d.mask.sum());
+    return d;
+}
+
+// Xavier/Glorot uniform initialisation scaled for the activation's slope at 0
+// (kSlope/4 instead of the logistic's 1/4); biases 0.
+std::vector<float> initial_weights(const Layout& lay, std::uint64_t seed) {
+    std::vector<float> w(std::size_t(lay.subnets) * std::size_t(lay.subnet_params), 0.0f);
+    SplitMix rng{seed};
+    for (int s = 0; s < lay.subnets; ++s)
+        for (const LayerLayout& L : lay.layers) {
+            const double a = std::sqrt(6.0 / double(L.in + L.out)) / (kSlope / 4.0) * 0.5;
+            float* p = w.data() + std::size_t(s) * std::size_t(lay.subnet_params) + L.w_offset;
+            for (int i = 0; i < L.in * L.out; ++i)
+                p[i] = float((2.0 * rng.uniform() - 1.0) * a);
+        }
+    return w;
+}
+
+thread_local Workspace tls_workspace;
+
+struct ErrorPair {
+    double rms = 0.0;
+    double mean_relative = 0.0;
+};
+
+// RMS of the encoded outputs and mean relative RGB error over a data set.
+ErrorPair evaluate_set(const Layout& lay, const NeuralSky& net, const DataSet& d) {
+    const MlpHD hd = make_mlp_hd(net);
+    struct Part {
+        double sq = 0.0, rel = 0.0;
+        std::size_t lit = 0;
+    };
+    const Part p = parallel_reduce_chunks(
+        d.size(), 2048, Part{},
+        [&](std::size_t lo, std::size_t hi) {
+            Part part;
+            MatF enc(4, Eigen::Index(hi - lo));
+            forward_network(lay, net.weights.data(), d.x.middleCols(Eigen::Index(lo), Eigen::Index(hi - lo)), enc,
+                            tls_workspace);
+            const MatF diff = ((enc - d.t.middleCols(Eigen::Index(lo), Eigen::Index(hi - lo))).array() *
+                               d.mask.middleCols(Eigen::Index(lo), Eigen::Index(hi - lo)).array())
+                                  .matrix();
+            part.sq = double(diff.squaredNorm());
+            for (std::size_t i = lo; i < hi; ++i) {
+                const glm::vec3 ref = d.radiance[i];
+                const float n = std::max({ref.x, ref.y, ref.z});
+                if (!(n > 0.0f))
+                    continue;
+                const glm::vec3 got = decode_sky(hd, enc.col(Eigen::Index(i - lo)).data());
+                const glm::dvec3 e = glm::dvec3(got) - glm::dvec3(ref);
+                part.rel += std::sqrt(e.x * e.x + e.y * e.y + e.z * e.z) /
+                            std::sqrt(double(ref.x) * ref.x + double(ref.y) * ref.y + double(ref.z) * ref.z);
+                ++part.lit;
+            }
+            return part;
+        },
+        [](Part a, const Part& b) {
+            a.sq += b.sq;
+            a.rel += b.rel;
+            a.lit += b.lit;
+            return a;
+        });
+    return {std::sqrt(p.sq / std::max(1.0, d.mask_count)), p.lit ? p.rel / double(p.lit) : 0.0};
+}
+
+struct GradPart {
+    double loss = 0.0;
+    std::vector<double> g;
+};
+
+// Σ mask (y − t)² and its half-gradient over the columns idx[lo, hi) of d.
+GradPart batch_gradient(const Layout& lay, const std::vector<float>& w, const DataSet& d,
+                        const std::vector<std::uint32_t>& idx, std::size_t lo, std::size_t hi) {
+    constexpr std::size_t kChunk = 256;
+    const std::size_t P = w.size();
+    return parallel_reduce_chunks(
+        hi - lo, kChunk, GradPart{0.0, std::vector<double>(P, 0.0)},
+        [&](std::size_t b, std::size_t e) {
+            GradPart part{0.0, std::vector<double>(P, 0.0)};
+            const Eigen::Index n = Eigen::Index(e - b);
+            MatF x(4, n), t(4, n), m(4, n);
+            for (Eigen::Index j = 0; j < n; ++j) {
+                const Eigen::Index c = Eigen::Index(idx[lo + b + std::size_t(j)]);
+                x.col(j) = d.x.col(c);
+                t.col(j) = d.t.col(c);
+                m.col(j) = d.mask.col(c);
+            }
+            for (int s = 0; s < lay.subnets; ++s)
+                part.loss += subnet_loss_grad(lay, w.data(), s, x, t, m,
+                                              part.g.data() + std::size_t(s) * std::size_t(lay.subnet_params),
+                                              tls_workspace);
+            return part;
+        },
+        [](GradPart a, const GradPart& b) {
+            a.loss += b.loss;
+            for (std::size_t i = 0; i < a.g.size(); ++i)
+                a.g[i] += b.g[i];
+            return a;
+        });
+}
+
+// Σ mask (y − t)² of sub-network s over the first n samples.
+double subnet_loss(const Layout& lay, const std::vector<float>& w, int s, const DataSet& d, std::size_t n) {
+    return parallel_reduce_chunks(
+        n, 4096, 0.0,
+        [&](std::size_t lo, std::size_t hi) {
+            const Eigen::Index a = Eigen::Index(lo), k = Eigen::Index(hi - lo);
+            return subnet_loss_grad(lay, w.data(), s, d.x.middleCols(a, k), d.t.middleCols(a, k),
+                                    d.mask.middleCols(a, k), nullptr, tls_workspace);
+        },
+        [](double a, double b) { return a + b; });
+}
+
+struct NormalPart {
+    Eigen::MatrixXd jtj;
+    Eigen::VectorXd jtr;
+    double loss = 0.0;
+};
+
+NormalPart normal_equations(const Layout& lay, const std::vector<float>& w, int s, const DataSet& d, std::size_t n) {
+    const int P = lay.subnet_params;
+    // At most ~16 partial matrices, whatever the thread count.
+    const std::size_t chunk = std::max<std::size_t>(8192, (n + 15) / 16);
+    NormalPart init{Eigen::MatrixXd::Zero(P, P), Eigen::VectorXd::Zero(P), 0.0};
+    return parallel_reduce_chunks(
+        n, chunk, init,
+        [&](std::size_t lo, std::size_t hi) {
+            Eigen::MatrixXf jtj = Eigen::MatrixXf::Zero(P, P);
+            Eigen::VectorXf jtr = Eigen::VectorXf::Zero(P);
+            NormalPart part{Eigen::MatrixXd::Zero(P, P), Eigen::VectorXd::Zero(P), 0.0};
+            constexpr std::size_t kBlock = 512, kFlush = 8192;
+            for (std::size_t b = lo; b < hi; b += kBlock) {
+                const Eigen::Index a = Eigen::Index(b), k = Eigen::Index(std::min(hi, b + kBlock) - b);
+                part.loss += subnet_normal_equations(lay, w.data(), s, d.x.middleCols(a, k), d.t.middleCols(a, k),
+                                                     d.mask.middleCols(a, k), jtj, jtr, tls_workspace);
+                if ((b - lo + kBlock) % kFlush == 0 || b + kBlock >= hi) { // flush float sums into double
+                    part.jtj += jtj.cast<double>();
+                    part.jtr += jtr.cast<double>();
+                    jtj.setZero();
+                    jtr.setZero();
+                }
+            }
+            return part;
+        },
+        [](NormalPart a, const NormalPart& b) {
+            a.jtj += b.jtj;
+            a.jtr += b.jtr;
+            a.loss += b.loss;
+            return a;
+        });
+}
+
+} // namespace
+
+NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, std::vector<LearningCurvePoint>* curve) {
+    o.topology.validate("--topology");
+    if (o.samples < 16 || o.samples > (std::size_t(1) << 31))
+        throw Error("the number of training samples must be 16 to 2^31", "--samples");
+    if (o.heldout_samples < 1 || o.max_n_samples < 1)
+        throw Error("held-out and max{N} sample counts must be at least 1", "--heldout");
+    if (o.adam_epochs < 0 || o.lm_iterations < 0 || o.adam_epochs + o.lm_iterations > 100000)
+        throw Error("epochs and LM iterations must be 0 to 100000", "--epochs/--lm-iterations");
+    if (o.batch < 1 || o.batch > o.samples)
+        throw Error("the mini-batch must hold 1 to --samples samples", "--batch");
+    if (!(o.learning_rate > 0.0 && o.learning_rate_final > 0.0 && o.learning_rate < 10.0))
+        throw Error("learning rates must be positive (and below 10)", "--learning-rate");
+    if (o.brightness == BrightnessEncoding::Log && !(o.log_range > 0.0 && o.log_range < 200.0))
+        throw Error("the log range must be in (0, 200) nats", "--log-range");
+
+    const auto t0 = std::chrono::steady_clock::now();
+    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+
+    NeuralSky net;
+    net.topology = o.topology;
+    net.atmosphere = model.atmosphere();
+    net.sky_options = model.options();
+    net.encoding.brightness = o.brightness;
+    net.encoding.log_range = o.log_range;
+    {   // max{N} over random samples (the seed's 100,000)
+        const std::vector<SkySample> s = draw_sky_samples(o.max_n_samples, stream_seed(o.seed, 2));
+        std::vector<glm::vec3> r(s.size());
+        evaluate_sky(model, s, r, SkyMethod::Tables);
+        double mx = 0.0;
+        for (const glm::vec3& c : r)
+            mx = std::max(mx, double(std::max({c.x, c.y, c.z})));
+        if (!(mx > 0.0))
+            throw Error("the sky is black on every sample; check the atmosphere's scattering coefficients",
+                        "atmosphere");
+        net.encoding.max_n = mx;
+    }
+    const DataSet train = make_data(model, net.encoding, o.samples, stream_seed(o.seed, 0));
+    const DataSet held = make_data(model, net.encoding, o.heldout_samples, stream_seed(o.seed, 1));
+
+    const Layout lay = make_layout(net.topology);
+    net.weights = initial_weights(lay, stream_seed(o.seed, 3));
+    const std::size_t P = net.weights.size();
+
+    Progress progress("train", std::uint64_t(o.adam_epochs + o.lm_iterations));
+    auto record = [&](int epoch, const char* phase, double train_rms) {
+        const ErrorPair h = evaluate_set(lay, net, held);
+        net.training.train_rms = train_rms;
+        net.training.heldout_rms = h.rms;
+        net.training.heldout_mean_relative = h.mean_relative;
+        if (curve)
+            curve->push_back({epoch, phase, train_rms, h.rms, h.mean_relative, elapsed()});
+        progress.advance();
+    };
+
+    // --- Adam --------------------------------------------------------------------
+    std::vector<double> m(P, 0.0), v(P, 0.0);
+    const double beta1 = 0.9, beta2 = 0.999, eps = 1e-8;
+    double beta1_t = 1.0, beta2_t = 1.0;
+    std::vector<std::uint32_t> perm(train.size());
+    std::iota(perm.begin(), perm.end(), 0u);
+    SplitMix shuffle_rng{stream_seed(o.seed, 4)};
+    for (int epoch = 0; epoch < o.adam_epochs; ++epoch) {
+        const double f = o.adam_epochs > 1 ? double(epoch) / double(o.adam_epochs - 1) : 0.0;
+        const double lr = o.learning_rate * std::pow(o.learning_rate_final / o.learning_rate, f);
+        for (std::size_t i = perm.size() - 1; i > 0; --i) // Fisher–Yates
+            std::swap(perm[i], perm[std::size_t(shuffle_rng.next() % (i + 1))]);
+        double epoch_loss = 0.0;
+        for (std::size_t lo = 0; lo < train.size(); lo += o.batch) {
+            const std::size_t hi = std::min(train.size(), lo + o.batch);
+            const GradPart g = batch_gradient(lay, net.weights, train, perm, lo, hi);
+            epoch_loss += g.loss;
+            beta1_t *= beta1;
+            beta2_t *= beta2;
+            const double scale = 1.0 / double(hi - lo);
+            const double step = lr * std::sqrt(1.0 - beta2_t) / (1.0 - beta1_t);
+            for (std::size_t i = 0; i < P; ++i) {
+                const double gi = g.g[i] * scale;
+                m[i] = beta1 * m[i] + (1.0 - beta1) * gi;
+                v[i] = beta2 * v[i] + (1.0 - beta2) * gi * gi;
+                net.weights[i] -= float(step * m[i] / (std::sqrt(v[i]) + eps));
+            }
+        }
+        record(epoch + 1, "adam", std::sqrt(epoch_loss / std::max(1.0, train.mask_count)));
+    }
+
+    // --- Levenberg–Marquardt, one sub-network at a time --------------------------------
+    const double Pd = double(lay.subnet_params);
+    const std::size_t n_lm =
+        o.lm_samples ? std::min(o.lm_samples, train.size())
+                     : std::min(train.size(),
+                                std::max(std::size_t(40.0 * Pd), std::size_t(std::min(2e5, 1.6e10 / (Pd * Pd)))));
+    std::vector<double> lambda(std::size_t(lay.subnets), 1e-3);
+    std::vector<bool> done(std::size_t(lay.subnets), false);
+    int lm_run = 0;
+    for (int it = 0; it < o.lm_iterations; ++it) {
+        bool any = false;
+        for (int s = 0; s < lay.subnets; ++s) {
+            if (done[std::size_t(s)])
+                continue;
+            any = true;
+            const NormalPart ne = normal_equations(lay, net.weights, s, train, n_lm);
+            Eigen::MatrixXd A = ne.jtj.selfadjointView<Eigen::Lower>();
+            const Eigen::VectorXd diag = A.diagonal();
+            const double floor = 1e-9 * std::max(1e-30, diag.mean());
+            float* ws = net.weights.data() + std::size_t(s) * std::size_t(lay.subnet_params);
+            const std::vector<float> saved(ws, ws + lay.subnet_params);
+            bool accepted = false;
+            for (int attempt = 0; attempt < 10 && !accepted; ++attempt) {
+                Eigen::MatrixXd Ad = A;
+                Ad.diagonal() += lambda[std::size_t(s)] * diag + Eigen::VectorXd::Constant(A.rows(), floor);
+                const Eigen::VectorXd step = Ad.ldlt().solve(-ne.jtr);
+                for (int i = 0; i < lay.subnet_params; ++i)
+                    ws[i] = float(double(saved[std::size_t(i)]) + step(i));
+                const double loss = step.allFinite() ? subnet_loss(lay, net.weights, s, train, n_lm) : INFINITY;
+                if (loss < ne.loss) {
+                    accepted = true;
+                    lambda[std::size_t(s)] = std::max(1e-12, lambda[std::size_t(s)] / 3.0);
+                    if (ne.loss - loss < 1e-7 * ne.loss)
+                        done[std::size_t(s)] = true; // converged
+                } else {
+                    std::copy(saved.begin(), saved.end(), ws);
+                    lambda[std::size_t(s)] *= 4.0;
+                }
+            }
+            if (!accepted)
+                done[std::size_t(s)] = true;
+        }
+        if (!any)
+            break;
+        ++lm_run;
+        double train_loss = 0.0;
+        for (int s = 0; s < lay.subnets; ++s)
+            train_loss += subnet_loss(lay, net.weights, s, train, train.size());
+        record(o.adam_epochs + lm_run, "lm", std::sqrt(train_loss / std::max(1.0, train.mask_count)));
+    }
+    progress.finish();
+    if (o.adam_epochs + lm_run == 0) { // nothing trained: still fill in the summary
+        const ErrorPair h = evaluate_set(lay, net, held);
+        net.training.train_rms = evaluate_set(lay, net, train).rms;
+        net.training.heldout_rms = h.rms;
+        net.training.heldout_mean_relative = h.mean_relative;
+    }
+    net.training.samples = o.samples;
+    net.training.heldout_samples = o.heldout_samples;
+    net.training.seed = o.seed;
+    net.training.adam_epochs = o.adam_epochs;
+    net.training.lm_iterations = lm_run;
+    net.training.threads = thread_count();
+    net.training.seconds = elapsed();
+    return net;
+}
+
+} // namespace skybake
