@@ -308,7 +308,7 @@ NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, s
     const std::size_t n_lm =
         o.lm_samples ? std::min(o.lm_samples, train.size())
                      : std::min(train.size(),
-                                std::max(std::size_t(40.0 * Pd), std::size_t(std::min(2e5, 1.6e10 / (Pd * Pd)))));
+                                std::max(std::size_t(10.0 * Pd), std::size_t(std::min(2e5, 4e9 / (Pd * Pd)))));
     std::vector<double> lambda(std::size_t(lay.subnets), 1e-3);
     std::vector<bool> done(std::size_t(lay.subnets), false);
     int lm_run = 0;

@@ -1,0 +1,387 @@
+// Unit tests of the neural sky: the seed's activation (closed form), layout
+// and weight counts, gradients and normal equations against finite
+// differences of an independent double-precision implementation, encoding,
+// inference paths, training (loss decrease, determinism), the weights file.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "neural/internal.h"
+#include "skybake/core.h"
+#include "skybake/error.h"
+#include "skybake/neural.h"
+
+using namespace skybake;
+using namespace skybake::neural;
+
+namespace {
+
+// Independent forward pass of one sub-network in double, plain loops.
+std::vector<double> ref_forward(const NeuralTopology& t, const double* w, const double in[4]) {
+    std::vector<int> widths{4};
+    widths.insert(widths.end(), t.hidden.begin(), t.hidden.end());
+    widths.push_back(t.outputs_per_subnet());
+    std::vector<double> a(in, in + 4);
+    std::size_t off = 0;
+    for (std::size_t l = 0; l + 1 < widths.size(); ++l) {
+        const int n_in = widths[l], n_out = widths[l + 1];
+        std::vector<double> z(static_cast<std::size_t>(n_out), 0.0);
+        for (int r = 0; r < n_out; ++r) {
+            double s = w[off + std::size_t(n_out * n_in + r)];
+            for (int c = 0; c < n_in; ++c)
+                s += w[off + std::size_t(r * n_in + c)] * a[std::size_t(c)];
+            z[std::size_t(r)] = 1.0 / (1.0 + std::pow(2.0, 2.0 * s)); // the seed's f
+        }
+        off += std::size_t(n_out * (n_in + 1));
+        a = z;
+    }
+    return a;
+}
+
+struct Batch {
+    MatF x, t, mask;
+};
+
+Batch random_batch(int n, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f), u01(0.05f, 0.95f);
+    Batch b{MatF(4, n), MatF(4, n), MatF(4, n)};
+    for (int j = 0; j < n; ++j) {
+        for (int k = 0; k < 3; ++k)
+            b.x(k, j) = u(rng);
+        b.x(3, j) = 0.5f * (u(rng) + 1.0f);
+        const bool night = j % 5 == 0;
+        for (int k = 0; k < 4; ++k) {
+            b.t(k, j) = night ? 0.0f : u01(rng);
+            b.mask(k, j) = night && k < 3 ? 0.0f : 1.0f;
+        }
+    }
+    return b;
+}
+
+std::vector<float> random_weights(const NeuralTopology& t, unsigned seed, float scale = 1.0f) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-scale, scale);
+    std::vector<float> w(std::size_t(t.weight_count()));
+    for (float& v : w)
+        v = u(rng);
+    return w;
+}
+
+// ½ Σ mask (y − t)² of sub-network s in double.
+double ref_loss(const NeuralTopology& t, const std::vector<double>& w, int s, const Batch& b) {
+    const int ops = t.outputs_per_subnet();
+    const std::size_t P = std::size_t(t.subnet_weight_count());
+    double loss = 0.0;
+    for (Eigen::Index j = 0; j < b.x.cols(); ++j) {
+        const double in[4] = {b.x(0, j), b.x(1, j), b.x(2, j), b.x(3, j)};
+        const std::vector<double> y = ref_forward(t, w.data() + std::size_t(s) * P, in);
+        for (int o = 0; o < ops; ++o) {
+            const int row = s * ops + o;
+            const double e = y[std::size_t(o)] - b.t(row, j);
+            loss += 0.5 * b.mask(row, j) * e * e;
+        }
+    }
+    return loss;
+}
+
+NeuralSky tiny_net(const NeuralTopology& t, unsigned seed) {
+    NeuralSky net;
+    net.topology = t;
+    net.weights = random_weights(t, seed, 1.5f);
+    net.encoding.max_n = 0.15;
+    net.atmosphere = atmosphere_preset("paper");
+    return net;
+}
+
+} // namespace
+
+TEST(NeuralActivation, SeedClosedForm) {
+    // REFERENCE.md: 1/(1 + 2^(2x)) is 0.5 at 0 with slope −ln2/2 ≈ −0.3466 there.
+    EXPECT_FLOAT_EQ(seed_activation(0.0f), 0.5f);
+    const float h = 1e-3f;
+    EXPECT_NEAR((seed_activation(h) - seed_activation(-h)) / (2 * h), -std::log(2.0) / 2.0, 1e-4);
+    EXPECT_NEAR(seed_activation(1.0f), 0.2f, 1e-7);  // 1/(1+4)
+    EXPECT_NEAR(seed_activation(-1.0f), 0.8f, 1e-7); // 1/(1+1/4)
+}
+
+TEST(NeuralTopology, SeedHas324Weights) {
+    const NeuralTopology paper = parse_topology("paper");
+    EXPECT_FALSE(paper.shared);
+    EXPECT_EQ(paper.hidden, (std::vector<int>{8, 4}));
+    EXPECT_EQ(paper.subnet_weight_count(), 81); // (4+1)·8 + (8+1)·4 + (4+1)·1
+    EXPECT_EQ(paper.weight_count(), 324);
+    EXPECT_EQ(paper.name(), "paper");
+    const NeuralTopology big = parse_topology("independent:32x32");
+    EXPECT_EQ(big.weight_count(), 4 * (5 * 32 + 33 * 32 + 33)); // 4996
+    const NeuralTopology shared = parse_topology("shared:64x64");
+    EXPECT_TRUE(shared.shared);
+    EXPECT_EQ(shared.weight_count(), 5 * 64 + 65 * 64 + 65 * 4);
+    EXPECT_EQ(parse_topology(shared.name()).hidden, shared.hidden);
+    const Layout lay = make_layout(paper);
+    EXPECT_EQ(lay.subnet_params, 81);
+    ASSERT_EQ(lay.layers.size(), 3u);
+    EXPECT_EQ(lay.layers[1].w_offset, 40);
+    for (const char* bad : {"", "papers", "independent:", "independent:8x", "shared:0", "shared:129", "x:8",
+                            "independent:1x2x3x4x5x6x7x8", "independent:8,4"})
+        EXPECT_THROW(parse_topology(bad), Error) << bad;
+}
+
+TEST(NeuralGradient, MatchesFiniteDifferencesOfAnIndependentDoubleImplementation) {
+    for (const char* name : {"paper", "shared:6x5x3"}) {
+        const NeuralTopology t = parse_topology(name);
+        const Layout lay = make_layout(t);
+        const std::vector<float> w = random_weights(t, 7, 0.8f);
+        const Batch b = random_batch(64, 3);
+        for (int s = 0; s < lay.subnets; ++s) {
+            std::vector<double> grad(std::size_t(lay.subnet_params), 0.0);
+            Workspace ws;
+            const double loss = subnet_loss_grad(lay, w.data(), s, b.x, b.t, b.mask, grad.data(), ws);
+            std::vector<double> wd(w.begin(), w.end());
+            EXPECT_NEAR(0.5 * loss, ref_loss(t, wd, s, b), 1e-5 * (1.0 + loss)) << name;
+            double gmax = 0.0;
+            for (double g : grad)
+                gmax = std::max(gmax, std::abs(g));
+            for (int i = 0; i < lay.subnet_params; ++i) {
+                const std::size_t k = std::size_t(s * lay.subnet_params + i);
+                const double h = 1e-6;
+                wd[k] += h;
+                const double lp = ref_loss(t, wd, s, b);
+                wd[k] -= 2 * h;
+                const double lm = ref_loss(t, wd, s, b);
+                wd[k] += h;
+                EXPECT_NEAR(grad[std::size_t(i)], (lp - lm) / (2 * h), 2e-4 * gmax) << name << " param " << i;
+            }
+        }
+    }
+}
+
+TEST(NeuralGradient, NormalEquationsAreJacobianProducts) {
+    // Jᵀr equals the gradient of ½Σr²; the diagonal of JᵀJ equals Σ (∂y/∂w)²
+    // from finite differences of the double implementation.
+    for (const char* name : {"paper", "shared:5x4"}) {
+        const NeuralTopology t = parse_topology(name);
+        const Layout lay = make_layout(t);
+        const std::vector<float> w = random_weights(t, 11, 0.8f);
+        const Batch b = random_batch(48, 5);
+        const int s = 0;
+        const int P = lay.subnet_params;
+        Eigen::MatrixXf jtj = Eigen::MatrixXf::Zero(P, P);
+        Eigen::VectorXf jtr = Eigen::VectorXf::Zero(P);
+        Workspace ws;
+        const double loss = subnet_normal_equations(lay, w.data(), s, b.x, b.t, b.mask, jtj, jtr, ws);
+        std::vector<double> grad(std::size_t(P), 0.0);
+        const double loss2 = subnet_loss_grad(lay, w.data(), s, b.x, b.t, b.mask, grad.data(), ws);
+        EXPECT_NEAR(loss, loss2, 1e-6 * loss);
+        for (int i = 0; i < P; ++i)
+            EXPECT_NEAR(jtr(i), grad[std::size_t(i)], 1e-4 * (1.0 + std::abs(grad[std::size_t(i)]))) << name;
+        // Finite-difference Jacobian, double.
+        std::vector<double> wd(w.begin(), w.end());
+        Eigen::MatrixXd J(b.x.cols() * lay.outputs, P);
+        for (int i = 0; i < P; ++i) {
+            const double h = 1e-6;
+            for (Eigen::Index j = 0; j < b.x.cols(); ++j) {
+                const double in[4] = {b.x(0, j), b.x(1, j), b.x(2, j), b.x(3, j)};
+                wd[std::size_t(i)] += h;
+                const std::vector<double> yp = ref_forward(t, wd.data(), in);
+                wd[std::size_t(i)] -= 2 * h;
+                const std::vector<double> ym = ref_forward(t, wd.data(), in);
+                wd[std::size_t(i)] += h;
+                for (int o = 0; o < lay.outputs; ++o)
+                    J(j * lay.outputs + o, i) = b.mask(o, j) * (yp[std::size_t(o)] - ym[std::size_t(o)]) / (2 * h);
+            }
+        }
+        const Eigen::MatrixXd ref = J.transpose() * J;
+        const double scale = ref.diagonal().maxCoeff();
+        for (int i = 0; i < P; ++i)
+            for (int k = 0; k <= i; ++k)
+                EXPECT_NEAR(jtj(i, k), ref(i, k), 1e-4 * scale) << name << " " << i << "," << k;
+    }
+}
+
+TEST(NeuralInference, BatchScalarAndDoubleAgree) {
+    for (const char* name : {"paper", "independent:16x16", "shared:12x8"}) {
+        for (BrightnessEncoding enc : {BrightnessEncoding::Log, BrightnessEncoding::Seed}) {
+            NeuralSky net = tiny_net(parse_topology(name), 21);
+            net.encoding.brightness = enc;
+            const std::vector<SkySample> s = draw_sky_samples(3000, 9);
+            std::vector<glm::vec3> batch(s.size());
+            evaluate_neural_sky(net, s, batch);
+            const MlpHD hd = make_mlp_hd(net);
+            const std::vector<double> wd(net.weights.begin(), net.weights.end());
+            for (std::size_t i = 0; i < s.size(); ++i) {
+                const glm::vec3 scalar = neural_sky_radiance(net, s[i]);
+                EXPECT_NEAR(glm::length(batch[i] - scalar), 0.0f, 1e-5f * (glm::length(scalar) + 1e-12f)) << name;
+                // Encoded outputs against the double implementation.
+                float enc4[4];
+                neural_sky_encoded(net, s[i], enc4);
+                const double in[4] = {s[i].cos_view_zenith, s[i].cos_view_sun, s[i].cos_sun_zenith, s[i].density};
+                for (int k = 0; k < 4; ++k) {
+                    const int sub = net.topology.shared ? 0 : k;
+                    const std::vector<double> y =
+                        ref_forward(net.topology, wd.data() + std::size_t(sub * net.topology.subnet_weight_count()), in);
+                    EXPECT_NEAR(enc4[k], y[net.topology.shared ? std::size_t(k) : 0], 2e-6) << name;
+                }
+            }
+            (void)hd;
+        }
+    }
+}
+
+TEST(NeuralEncoding, RoundTripsAndNight) {
+    for (BrightnessEncoding b : {BrightnessEncoding::Log, BrightnessEncoding::Seed}) {
+        NeuralEncoding e;
+        e.brightness = b;
+        e.max_n = 0.2;
+        for (const glm::vec3 c : {glm::vec3(0.01f, 0.02f, 0.04f), glm::vec3(0.1f, 0.05f, 0.001f),
+                                  glm::vec3(0.2f, 0.2f, 0.2f), glm::vec3(3e-4f, 1e-4f, 0.0f)}) {
+            float enc[4];
+            encode_sky_radiance(e, c, enc);
+            for (float v : enc) {
+                EXPECT_GE(v, 0.05f);
+                EXPECT_LE(v, 0.95f + 1e-6f);
+            }
+            EXPECT_NEAR(std::max({enc[0], enc[1], enc[2]}), 0.95f, 1e-6f); // the largest channel is N itself
+            const glm::vec3 d = decode_sky_radiance(e, enc);
+            EXPECT_NEAR(glm::length(d - c), 0.0f, 2e-5f * glm::length(c));
+        }
+        float enc[4];
+        encode_sky_radiance(e, glm::vec3(0.0f), enc); // night: M = 0
+        EXPECT_EQ(enc[3], 0.0f);
+        EXPECT_EQ(decode_sky_radiance(e, enc), glm::vec3(0.0f));
+    }
+    // Log: N below max{N}·e^(−range) clamps to the darkest code 0.05, still "day".
+    NeuralEncoding e;
+    e.max_n = 1.0;
+    e.log_range = std::log(1e3);
+    float enc[4];
+    encode_sky_radiance(e, glm::vec3(1e-5f), enc);
+    EXPECT_FLOAT_EQ(enc[3], 0.05f);
+    encode_sky_radiance(e, glm::vec3(1e-2f), enc); // 1 + ln(1e-2)/ln(1e3) = 1/3
+    EXPECT_NEAR(enc[3], 0.05f + 0.9f / 3.0f, 1e-6f);
+}
+
+TEST(NeuralTraining, LossDecreasesAndIsDeterministic) {
+    SkyModelOptions so;
+    so.tables = {64, 32};
+    so.steps = 8;
+    const SkyModel model(atmosphere_preset("paper-dense"), so);
+    NeuralTrainOptions o;
+    o.samples = 4000;
+    o.heldout_samples = 1000;
+    o.max_n_samples = 2000;
+    o.adam_epochs = 6;
+    o.batch = 256;
+    o.lm_iterations = 4;
+    o.progress = false;
+    std::vector<LearningCurvePoint> curve;
+    const int threads = thread_count();
+    set_thread_count(2);
+    const NeuralSky a = train_neural_sky(model, o, &curve);
+    set_thread_count(1);
+    const NeuralSky b = train_neural_sky(model, o);
+    set_thread_count(threads);
+    ASSERT_EQ(a.weights.size(), 324u);
+    EXPECT_EQ(a.weights, b.weights); // bitwise, whatever the thread count
+    ASSERT_GE(curve.size(), 7u);
+    EXPECT_EQ(curve.front().phase, "adam");
+    EXPECT_EQ(curve.back().phase, "lm");
+    EXPECT_LT(curve.back().train_rms, 0.6 * curve.front().train_rms);
+    EXPECT_LT(curve.back().heldout_rms, 0.6 * curve.front().heldout_rms);
+    for (std::size_t i = std::size_t(o.adam_epochs) + 1; i < curve.size(); ++i) // LM only accepts improvements
+        EXPECT_LE(curve[i].train_rms, curve[i - 1].train_rms * (1.0 + 1e-6));
+    EXPECT_GT(a.encoding.max_n, 0.0);
+    EXPECT_EQ(a.training.samples, 4000u);
+}
+
+TEST(NeuralFile, RoundTripIsExact) {
+    NeuralSky net = tiny_net(parse_topology("independent:6x5"), 3);
+    net.training.seconds = 12.5;
+    const NeuralSky back = neural_sky_from_json(neural_sky_to_json(net));
+    EXPECT_EQ(back.weights, net.weights);
+    EXPECT_EQ(back.topology.hidden, net.topology.hidden);
+    EXPECT_EQ(back.encoding.max_n, net.encoding.max_n);
+    EXPECT_EQ(back.atmosphere.name, net.atmosphere.name);
+    EXPECT_EQ(back.atmosphere.planet_radius_km, net.atmosphere.planet_radius_km);
+    EXPECT_EQ(back.training.seconds, 12.5);
+}
+
+TEST(NeuralFile, CorruptOrMismatchedFilesAreClearErrors) {
+    const NeuralSky net = tiny_net(parse_topology("paper"), 4);
+    const nlohmann::json good = nlohmann::json::parse(neural_sky_to_json(net));
+    auto expect_error = [](const std::string& text, const std::string& needle) {
+        try {
+            neural_sky_from_json(text, "w.json");
+            ADD_FAILURE() << "accepted: " << needle;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+            EXPECT_EQ(e.where().rfind("w.json", 0), 0u);
+        }
+    };
+    const std::string text = good.dump();
+    expect_error(text.substr(0, text.size() / 2), "not valid JSON");
+    expect_error("[1,2,3]", "not a neural sky weights file");
+    nlohmann::json j = good;
+    j["version"] = 99;
+    expect_error(j.dump(), "version");
+    j = good;
+    j["weights"][2].erase(0);
+    expect_error(j.dump(), "sub-network 2 must have 81 weights");
+    j = good;
+    j["topology"]["hidden"] = {8, 5}; // weights no longer fit the topology
+    expect_error(j.dump(), "must have 91 weights");
+    j = good;
+    j["weights"][0][3] = "x";
+    expect_error(j.dump(), "not a number");
+    j = good;
+    j["encoding"]["max_n"] = -1.0;
+    expect_error(j.dump(), "max_n");
+    j = good;
+    j["atmosphere"]["planet_radius_km"] = -5.0;
+    expect_error(j.dump(), "atmosphere");
+    j = good;
+    j.erase("sky_model");
+    expect_error(j.dump(), "sky_model");
+    j = good;
+    j["topology"]["hidden"] = {300};
+    expect_error(j.dump(), "width");
+    // Non-finite weights cannot be written in JSON, but can be set in memory.
+    NeuralSky bad = net;
+    bad.weights[5] = NAN;
+    EXPECT_THROW(bad.validate(), Error);
+}
+
+TEST(NeuralStats, PercentilesByNearestRank) {
+    std::vector<double> e;
+    for (int i = 100; i >= 1; --i)
+        e.push_back(i / 100.0);
+    const ErrorStats s = error_stats(e);
+    EXPECT_EQ(s.count, 100u);
+    EXPECT_NEAR(s.mean, 0.505, 1e-12);
+    EXPECT_DOUBLE_EQ(s.p50, 0.50);
+    EXPECT_DOUBLE_EQ(s.p95, 0.95);
+    EXPECT_DOUBLE_EQ(s.p99, 0.99);
+    EXPECT_DOUBLE_EQ(s.max, 1.0);
+}
+
+TEST(NeuralChart, DrawsAxesAndBothCurves) {
+    ChartSeries a{"training", glm::vec3(0, 0, 1), {1, 2, 3, 4}, {0.1, 0.05, 0.02, 0.01}};
+    ChartSeries b{"held-out", glm::vec3(1, 0, 0), {1, 2, 3, 4}, {0.12, 0.06, 0.03, 0.02}};
+    const Image img = draw_line_chart({a, b}, "test", "epoch", "rms", 400, 300);
+    ASSERT_EQ(img.width, 400);
+    int blue = 0, red = 0, black = 0;
+    for (std::size_t i = 0; i < img.rgb.size(); i += 3) {
+        const float r = img.rgb[i], g = img.rgb[i + 1], bb = img.rgb[i + 2];
+        blue += r == 0 && g == 0 && bb == 1;
+        red += r == 1 && g == 0 && bb == 0;
+        black += r == 0 && g == 0 && bb == 0;
+    }
+    EXPECT_GT(blue, 200);
+    EXPECT_GT(red, 200);
+    EXPECT_GT(black, 500); // axes, ticks and labels
+}
