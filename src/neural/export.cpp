@@ -121,7 +121,8 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const s
         o << fmt::format("{} {}({}) {{\n", d.vec3, name, params);
     else
         o << fmt::format("{}void {}({}, float rgb[3]) {{\n", lang == ExportLanguage::C ? "" : qual, name, params);
-    o << "    const float in0 = cos_view_zenith, in1 = cos_view_sun, in2 = cos_sun_zenith, in3 = density;\n";
+    const char* cst = d.shader ? "" : "const ";
+    o << "    " << cst << "float in0 = cos_view_zenith, in1 = cos_view_sun, in2 = cos_sun_zenith, in3 = density;\n";
     const char* out_names[] = {"R", "G", "B", "M"};
     std::vector<std::string> outputs;
     for (int s = 0; s < lay.subnets; ++s) {
@@ -146,7 +147,7 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const s
                 }
                 const float bv = w[L.b_offset + r];
                 e += std::signbit(bv) ? fmt::format(" - {}", lit(-bv, d)) : fmt::format(" + {}", lit(bv, d));
-                o << fmt::format("    const float {} = {}({});\n", v, f, e);
+                o << fmt::format("    {}float {} = {}({});\n", d.shader ? "" : "const ", v, f, e);
                 cur.push_back(v);
             }
             prev = std::move(cur);
@@ -156,18 +157,18 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const s
     }
     const std::string inv = lit(1.0f / kEncodeScale, d), off = lit(kEncodeOffset, d), zero = lit(0.0f, d);
     o << "    // decoding: (x - 0.05)/0.9, values below 0.05 are 0; N from the brightness output\n";
-    o << fmt::format("    const float m = ({} - {}) * {};\n", outputs[3], off, inv);
+    o << fmt::format("    {}float m = ({} - {}) * {};\n", cst, outputs[3], off, inv);
     if (d.shader)
         o << fmt::format("    if (!(m > {})) return {}({});\n", zero, d.vec3, zero);
     else
         o << fmt::format("    if (!(m > {})) {{ rgb[0] = rgb[1] = rgb[2] = {}; return; }}\n", zero, zero);
     if (net.encoding.brightness == BrightnessEncoding::Seed)
-        o << fmt::format("    const float n = m * {};\n", lit(float(net.encoding.max_n), d));
+        o << fmt::format("    {}float n = m * {};\n", cst, lit(float(net.encoding.max_n), d));
     else
-        o << fmt::format("    const float n = {} * {}({} * (m - {}));\n", lit(float(net.encoding.max_n), d), d.exp,
+        o << fmt::format("    {}float n = {} * {}({} * (m - {}));\n", cst, lit(float(net.encoding.max_n), d), d.exp,
                          lit(float(net.encoding.log_range), d), lit(1.0f, d));
     for (int k = 0; k < 3; ++k)
-        o << fmt::format("    const float c{} = ({} - {}) * {};\n", k, outputs[std::size_t(k)], off, inv);
+        o << fmt::format("    {}float c{} = ({} - {}) * {};\n", cst, k, outputs[std::size_t(k)], off, inv);
     if (d.shader)
         o << fmt::format("    return max({}(c0, c1, c2), {}({})) * n;\n", d.vec3, d.vec3, zero);
     else
