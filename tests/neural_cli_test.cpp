@@ -1,0 +1,209 @@
+// End-to-end tests of the neural sky commands: sky train, sky eval/render
+// --model, sky export, sky error; exit codes, one-line errors, no partial output.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.h"
+
+using skybake::test::run_cli;
+using skybake::test::temp_dir;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string read(const std::string& path) {
+    std::ifstream f(path);
+    std::stringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+std::string write(const std::string& dir, const std::string& name, const std::string& text) {
+    const std::string path = dir + "/" + name;
+    std::ofstream(path) << text;
+    return path;
+}
+
+int count_lines(const std::string& text) {
+    int n = 0;
+    for (char c : text)
+        n += c == '\n';
+    return n;
+}
+
+// A quickly trained small network, shared by the tests of one run.
+const std::string& tiny_model() {
+    static const std::string path = [] {
+        const std::string dir = temp_dir("neural_model");
+        const std::string p = dir + "/tiny.json";
+        auto r = run_cli({"sky", "train", "--preset", "paper-dense", "--samples", "3000", "--heldout", "500",
+                          "--epochs", "3", "--lm-iterations", "2", "--batch", "256", "-o", p});
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        return p;
+    }();
+    return path;
+}
+
+} // namespace
+
+TEST(NeuralCli, TrainWritesWeightsCurveAndChart) {
+    const std::string dir = temp_dir("neural_train");
+    auto r = run_cli({"sky", "train", "--preset", "paper", "--samples", "2000", "--heldout", "300", "--epochs", "2",
+                      "--lm-iterations", "2", "--batch", "200", "--topology", "shared:6x6", "-o", dir + "/w.json",
+                      "--curve", dir + "/c.csv", "--chart", dir + "/c.png", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["topology"], "shared:6x6");
+    EXPECT_EQ(j["weights"], 5 * 6 + 7 * 6 + 7 * 4);
+    EXPECT_EQ(j["samples"], 2000);
+    EXPECT_GT(j["max_n"].get<double>(), 0.0);
+    const auto w = nlohmann::json::parse(read(dir + "/w.json"));
+    EXPECT_EQ(w["format"], "skybake-neural-sky");
+    EXPECT_EQ(w["atmosphere"]["planet_radius_km"], 6371.0);
+    const std::string csv = read(dir + "/c.csv");
+    EXPECT_EQ(csv.rfind("epoch,phase,train_rms,heldout_rms", 0), 0u);
+    EXPECT_EQ(count_lines(csv), 1 + 2 + j["lm_iterations"].get<int>());
+    EXPECT_GT(fs::file_size(dir + "/c.png"), 1000u);
+}
+
+TEST(NeuralCli, TrainRejectsBadFlags) {
+    const std::string dir = temp_dir("neural_train_bad");
+    for (const auto& args : std::vector<std::vector<std::string>>{
+             {"--topology", "wide"},
+             {"--topology", "independent:0"},
+             {"--brightness", "cubic"},
+             {"--samples", "3"},
+             {"--chart", dir + "/c.jpg"},
+             {"--preset", "mars"}}) {
+        std::vector<std::string> a{"sky", "train", "-o", dir + "/w.json"};
+        a.insert(a.end(), args.begin(), args.end());
+        auto r = run_cli(a);
+        EXPECT_EQ(r.exit_code, 1) << args[0];
+        EXPECT_EQ(r.err_lines(), 1) << r.err;
+        EXPECT_EQ(r.err.rfind("skybake: error: ", 0), 0u) << r.err;
+        EXPECT_FALSE(fs::exists(dir + "/w.json"));
+    }
+}
+
+TEST(NeuralCli, EvalWithModelTakesTheSameCsv) {
+    const std::string dir = temp_dir("neural_eval");
+    const std::string in = write(dir, "in.csv",
+                                 "cos_view_zenith,cos_view_sun,cos_sun_zenith,density\n"
+                                 "1,1,1,1\n0.5,0.2,0.7,0.3\n-0.2,0.1,0.5,0.9\n0.3,-0.285,-0.95,0.5\n");
+    auto r = run_cli({"sky", "eval", "--model", tiny_model(), "--input", in, "--output", dir + "/out.csv", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["method"], "neural");
+    std::istringstream out(read(dir + "/out.csv"));
+    std::string line;
+    std::getline(out, line);
+    EXPECT_EQ(line, "r,g,b");
+    int rows = 0;
+    while (std::getline(out, line)) {
+        double a, b, c;
+        char k1, k2;
+        std::istringstream(line) >> a >> k1 >> b >> k2 >> c;
+        EXPECT_TRUE(std::isfinite(a) && a >= 0 && b >= 0 && c >= 0) << line;
+        ++rows;
+    }
+    EXPECT_EQ(rows, 4);
+    // The same bad input errors as the reference model.
+    const std::string bad = write(dir, "bad.csv", "1,1,1,1\n0.9,0.9,-0.9,0.5\n");
+    auto e = run_cli({"sky", "eval", "--model", tiny_model(), "--input", bad, "--output", dir + "/bad_out.csv"});
+    EXPECT_EQ(e.exit_code, 1);
+    EXPECT_EQ(e.err_lines(), 1);
+    EXPECT_NE(e.err.find("line 2"), std::string::npos) << e.err;
+    EXPECT_FALSE(fs::exists(dir + "/bad_out.csv"));
+    // The weights file carries its atmosphere.
+    auto p = run_cli({"sky", "eval", "--model", tiny_model(), "--preset", "earth", "--input", in, "--output",
+                      dir + "/p.csv"});
+    EXPECT_EQ(p.exit_code, 1);
+    EXPECT_EQ(p.err_lines(), 1);
+    EXPECT_NE(p.err.find("--preset"), std::string::npos) << p.err;
+}
+
+TEST(NeuralCli, RenderWithModel) {
+    const std::string dir = temp_dir("neural_render");
+    auto r = run_cli({"sky", "render", "--model", tiny_model(), "--altitude-km", "2", "--sun-elevation-deg", "20",
+                      "--view", "panorama", "--size", "64x32", "-o", dir + "/p.png", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["method"], "neural");
+    EXPECT_EQ(j["atmosphere"], "paper-dense");
+    EXPECT_GT(fs::file_size(dir + "/p.png"), 100u);
+    auto bad = run_cli({"sky", "render", "--model", tiny_model(), "--altitude-km", "2", "--sun-elevation-deg", "20",
+                        "--method", "exact", "-o", dir + "/x.png"});
+    EXPECT_EQ(bad.exit_code, 1);
+    EXPECT_EQ(bad.err_lines(), 1);
+    EXPECT_FALSE(fs::exists(dir + "/x.png"));
+}
+
+TEST(NeuralCli, ExportEveryFormat) {
+    const std::string dir = temp_dir("neural_export");
+    for (const char* f : {"glsl", "hlsl", "cuda", "c"}) {
+        const std::string out = dir + "/sky." + f;
+        auto r = run_cli({"sky", "export", tiny_model(), "--format", f, "-o", out, "--json"});
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        EXPECT_EQ(nlohmann::json::parse(r.out)["weights"], 324);
+        EXPECT_NE(read(out).find("skybake_sky("), std::string::npos) << f;
+    }
+    auto r = run_cli({"sky", "export", tiny_model(), "--format", "metal", "-o", dir + "/sky.metal"});
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.err_lines(), 1);
+    EXPECT_FALSE(fs::exists(dir + "/sky.metal"));
+    auto u = run_cli({"sky", "export", tiny_model(), "-o", dir + "/x.glsl"}); // --format missing: usage error
+    EXPECT_EQ(u.exit_code, 2);
+}
+
+TEST(NeuralCli, ErrorReport) {
+    const std::string dir = temp_dir("neural_error");
+    auto r = run_cli({"sky", "error", "--model", tiny_model(), "--samples", "2000", "--size", "48x32", "--views-dir",
+                      dir + "/views", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    const auto& rel = j["relative_error"];
+    const auto n = rel["all"]["count"].get<int>() + j["night_absolute_error_over_max_n"]["count"].get<int>();
+    EXPECT_EQ(n, 2000);
+    EXPECT_EQ(rel["all"]["count"].get<int>(), rel["day"]["count"].get<int>() + rel["twilight"]["count"].get<int>());
+    for (const char* k : {"all", "day", "twilight"}) {
+        const auto& s = rel[k];
+        EXPECT_LE(s["p50"].get<double>(), s["p95"].get<double>());
+        EXPECT_LE(s["p95"].get<double>(), s["p99"].get<double>());
+        EXPECT_LE(s["p99"].get<double>(), s["max"].get<double>());
+    }
+    ASSERT_EQ(j["views"].size(), 6u);
+    EXPECT_GT(j["min_view_psnr_db"].get<double>(), 0.0);
+    EXPECT_TRUE(fs::exists(dir + "/views/1_sea_level_neural.png"));
+    EXPECT_TRUE(fs::exists(dir + "/views/1_sea_level_reference.png"));
+    auto t = run_cli({"sky", "error", "--model", tiny_model(), "--samples", "500", "--no-views"});
+    ASSERT_EQ(t.exit_code, 0) << t.err;
+    EXPECT_NE(t.out.find("day (sun above horizon)"), std::string::npos);
+}
+
+TEST(NeuralCli, CorruptWeightsAreOneLineErrors) {
+    const std::string dir = temp_dir("neural_corrupt");
+    const std::string good = read(tiny_model());
+    const std::string truncated = write(dir, "truncated.json", good.substr(0, good.size() / 3));
+    auto j = nlohmann::json::parse(good);
+    j["weights"][1].erase(0);
+    const std::string short_w = write(dir, "short.json", j.dump());
+    const std::string other = write(dir, "other.json", "{\"format\": \"something\"}");
+    for (const std::string& f : {truncated, short_w, other, dir + "/missing.json"}) {
+        for (const std::vector<std::string>& cmd :
+             {std::vector<std::string>{"sky", "export", f, "--format", "glsl", "-o", dir + "/o.glsl"},
+              std::vector<std::string>{"sky", "error", "--model", f, "--no-views"},
+              std::vector<std::string>{"sky", "render", "--model", f, "--altitude-km", "0", "--sun-elevation-deg",
+                                       "10", "-o", dir + "/o.png"}}) {
+            auto r = run_cli(cmd);
+            EXPECT_EQ(r.exit_code, 1) << f << " " << cmd[1];
+            EXPECT_EQ(r.err_lines(), 1) << r.err;
+            EXPECT_NE(r.err.find(f), std::string::npos) << r.err; // names the file
+        }
+    }
+    EXPECT_FALSE(fs::exists(dir + "/o.glsl"));
+    EXPECT_FALSE(fs::exists(dir + "/o.png"));
+}
