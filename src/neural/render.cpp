@@ -1,8 +1,10 @@
 // Sky images with the neural sky: Pietras & Rudnicki (seed 000), section III
 // for the sky and the light scattered in front of the ground (one network
 // evaluation per view ray, at the point where the ray enters the atmosphere),
-// section IV for the reflected ground light and the sun disc, which come from
-// the optical-length tables. The camera, the planet and the ground are those
+// section IV for the ground: the in-scattered light in front of it is the
+// difference of two network evaluations (observer and a probe at the surface
+// point), the reflected light and the sun disc come from the optical-length
+// tables. The camera, the planet and the ground are those
 // of the sky module's renderer (src/sky/render_hd.h).
 #include <algorithm>
 #include <cmath>
@@ -40,6 +42,13 @@ glm::vec3 shade_ray_neural(const sky::RenderHD& p, const MlpHD& net, const glm::
         const glm::vec3 g(t * d.x, t * d.y, p.eye_r + t * d.z);
         const glm::vec3 n = g / glm::length(g);
         const float cos_sun = glm::dot(n, p.sun);
+        // Seed section IV: the light scattered between the observer and the
+        // surface is N(observer) − N(probe at the surface point, looking the
+        // same way). The probe's true value is 0 (its ray ends at once); the
+        // network's value there is its smoothing error across the horizon,
+        // which the difference removes.
+        if (inside)
+            c = glm::max(c - neural_sky(net, glm::dot(n, d), o.cvs, cos_sun, 1.0f), glm::vec3(0.0f));
         if (cos_sun > 0.0f) {
             glm::vec3 reflected = p.albedo * (cos_sun / sky::kPi) * sky::sun_transmittance(a, a.R0, 0.0f, cos_sun);
             if (p.seed_ground) {
