@@ -11,6 +11,7 @@ namespace {
 struct Entry {
     std::string group, key;
     AddCommandFn add;
+    bool group_command = false;
 };
 
 std::vector<Entry>& registry() {
@@ -34,8 +35,8 @@ const Group kGroups[] = {
 
 } // namespace
 
-CommandRegistration::CommandRegistration(const char* group, const char* key, AddCommandFn add) {
-    registry().push_back({group, key, add});
+CommandRegistration::CommandRegistration(const char* group, const char* key, AddCommandFn add, bool group_command) {
+    registry().push_back({group, key, add, group_command});
 }
 
 void add_all_commands(CLI::App& app) {
@@ -49,7 +50,8 @@ void add_all_commands(CLI::App& app) {
                 continue;
             if (!group) {
                 group = app.add_subcommand(g.name, g.description);
-                group->require_subcommand(1);
+                if (!e.group_command)
+                    group->require_subcommand(1);
             }
             e.add(*group);
         }

@@ -7,6 +7,13 @@
 //
 // Groups are created on first use, in the order of the table in commands.cpp;
 // sub-commands within a group are sorted by name, so --help is deterministic.
+//
+// A group that is itself the command (`skybake ao INPUT ...`) registers with
+//
+//     SKYBAKE_CLI_GROUP_COMMAND("ao", add_ao_bake)
+//
+// and its function configures the group's App directly (options, callback);
+// such a group takes no sub-commands.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -16,7 +23,7 @@ namespace skybake::cli {
 using AddCommandFn = void (*)(CLI::App& group);
 
 struct CommandRegistration {
-    CommandRegistration(const char* group, const char* key, AddCommandFn add);
+    CommandRegistration(const char* group, const char* key, AddCommandFn add, bool group_command = false);
 };
 
 // Adds every registered group and sub-command to the app.
@@ -26,3 +33,6 @@ void add_all_commands(CLI::App& app);
 
 #define SKYBAKE_CLI_COMMAND(group, fn)                                                                                 \
     static const ::skybake::cli::CommandRegistration fn##_registration(group, #fn, fn);
+
+#define SKYBAKE_CLI_GROUP_COMMAND(group, fn)                                                                           \
+    static const ::skybake::cli::CommandRegistration fn##_registration(group, #fn, fn, true);

@@ -1,0 +1,183 @@
+// skybake ao INPUT -o OUTPUT.glb|.ply [--rule R] [--backend B] [--max-distance D] [--offset E]
+//            [--back-faces occlude|ignore] [--normalize] [--bits FILE] [--preview FILE.png]
+//            [--preview-size WxH] [--json]
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "cli.h"
+#include "commands.h"
+#include "skybake/bake.h"
+#include "skybake/mesh.h"
+#include "skybake/sphere.h"
+#include "skybake/visibility.h"
+
+namespace skybake::cli {
+
+namespace {
+
+constexpr const char* kDefaultRule = "lebedev:590";
+
+struct AoOptions {
+    std::string input, output;
+    std::string rule = kDefaultRule;
+    std::string backend = "embree";
+    double max_distance = std::numeric_limits<double>::infinity();
+    double offset = -1.0;
+    std::string back_faces = "occlude";
+    bool normalize = false;
+    std::string bits;
+    std::string preview;
+    std::string preview_size = "960x720";
+    float azimuth_deg = 35.0f, elevation_deg = 30.0f;
+    bool json = false;
+};
+
+std::string lower_extension(const std::string& path) {
+    std::string e = std::filesystem::path(path).extension().string();
+    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return e;
+}
+
+nlohmann::json stats(const std::vector<float>& v) {
+    if (v.empty())
+        return nullptr;
+    double sum = 0.0;
+    float lo = v[0], hi = v[0];
+    for (float x : v) {
+        sum += x;
+        lo = std::min(lo, x);
+        hi = std::max(hi, x);
+    }
+    return {{"min", lo}, {"mean", sum / double(v.size())}, {"max", hi}};
+}
+
+void run(const AoOptions& o) {
+    // Everything that can be checked without the mesh is checked first, so a
+    // typo fails at once and no output file is started.
+    const SphereRule rule = parse_rule(o.rule);
+    const auto backend = make_visibility_backend(o.backend);
+    const std::string out_ext = lower_extension(o.output);
+    if (out_ext != ".glb" && out_ext != ".ply")
+        throw Error(fmt::format("cannot write '{}' meshes; use .glb or .ply", out_ext.empty() ? "(none)" : out_ext),
+                    "--output");
+    if (!o.preview.empty()) {
+        const std::string e = lower_extension(o.preview);
+        if (e != ".png" && e != ".exr")
+            throw Error(fmt::format("cannot write '{}' images; use .png or .exr", e.empty() ? "(none)" : e),
+                        "--preview");
+    }
+    AoPreviewOptions preview;
+    parse_size(o.preview_size, preview.width, preview.height, "--preview-size");
+    preview.azimuth_deg = o.azimuth_deg;
+    preview.elevation_deg = o.elevation_deg;
+    if (std::isnan(o.max_distance) || o.max_distance <= 0.0)
+        throw Error(fmt::format("maximum distance must be > 0 mesh units; got {}", o.max_distance), "--max-distance");
+    if (!std::isfinite(o.offset) || (o.offset < 0.0 && o.offset != -1.0))
+        throw Error(fmt::format("ray offset must be a finite distance ≥ 0 in mesh units; got {}", o.offset),
+                    "--offset");
+
+    BakeOptions b;
+    b.max_distance = float(o.max_distance);
+    b.ray_offset = float(o.offset);
+    b.back_faces = parse_back_faces(o.back_faces);
+    b.normalize = o.normalize;
+    b.store_bits = !o.bits.empty();
+
+    Mesh mesh = load_mesh(o.input);
+    BakeOutputs outputs;
+    const AoBakeReport r = bake_ambient_occlusion(mesh, rule, *backend, b, &outputs);
+
+    // Render before writing anything: a failure leaves no partial set of outputs.
+    Image image;
+    if (!o.preview.empty())
+        image = render_ao_preview(mesh, preview);
+    save_mesh(o.output, mesh);
+    if (!o.preview.empty())
+        save_image(o.preview, image, ToneMap{0.0f, ToneCurve::Clamp});
+    if (!o.bits.empty())
+        save_visibility_bits(o.bits, outputs, rule);
+
+    if (o.json) {
+        nlohmann::json j = {{"input", o.input},
+                            {"output", o.output},
+                            {"backend", r.backend},
+                            {"rule", r.rule},
+                            {"directions", r.directions},
+                            {"vertices", r.vertices},
+                            {"triangles", r.triangles},
+                            {"rays", r.rays},
+                            {"seconds", r.seconds},
+                            {"build_seconds", r.build_seconds},
+                            {"trace_seconds", r.trace_seconds},
+                            {"rays_per_second", r.rays_per_second()},
+                            {"ray_offset", r.ray_offset},
+                            {"max_distance", std::isfinite(b.max_distance) ? nlohmann::json(b.max_distance) : nullptr},
+                            {"back_faces", back_faces_name(b.back_faces)},
+                            {"normalize", b.normalize},
+                            {"negative_weights", r.negative_weights},
+                            {"clamped_vertices", r.clamped_vertices},
+                            {"ao", stats(outputs.ao)},
+                            {"shading", stats(outputs.shading)},
+                            {"preview", o.preview.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.preview)},
+                            {"bits", o.bits.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.bits)},
+                            {"threads", thread_count()}};
+        print_json(j);
+        return;
+    }
+    double mean = 0.0;
+    for (float a : outputs.ao)
+        mean += a;
+    mean /= double(std::max<std::size_t>(1, outputs.ao.size()));
+    info("baked {} vertices ({} triangles) with {} ({} directions, {}): {} rays in {:.2f} s ({:.1f} Mrays/s), "
+         "BVH {:.2f} s",
+         r.vertices, r.triangles, r.rule, r.directions, r.backend, r.rays, r.seconds, r.rays_per_second() * 1e-6,
+         r.build_seconds);
+    if (r.negative_weights)
+        info("note: {} has negative weights; {} vertices had sums outside [0, 1], clamped", r.rule,
+             r.clamped_vertices);
+    info("mean AO {:.4f}, ray offset {:.3g}; wrote {}{}{}", mean, r.ray_offset, o.output,
+         o.preview.empty() ? "" : ", " + o.preview, o.bits.empty() ? "" : ", " + o.bits);
+}
+
+} // namespace
+
+void add_ao_bake(CLI::App& group) {
+    auto o = std::make_shared<AoOptions>();
+    CLI::App* sub = &group;
+    sub->add_option("input", o->input, "Input mesh (any format 'mesh info' reads)")->required();
+    sub->add_option("-o,--output", o->output, "Output mesh with AO, shading and bent normals (.glb or .ply)")
+        ->required();
+    sub->add_option("--rule", o->rule,
+                    "Sphere rule, e.g. lebedev:5810, design:t21, fibonacci:1000, mc:4096; add +rotate for a random "
+                    "rotation per vertex (see 'sphere list')")
+        ->capture_default_str();
+    sub->add_option("--backend", o->backend, "Visibility backend: embree, or brute (test oracle, small meshes)")
+        ->capture_default_str();
+    sub->add_option("--max-distance", o->max_distance,
+                    "Ignore occluders further than this, in mesh units (default: unlimited)");
+    sub->add_option("--offset", o->offset,
+                    "Move ray origins this far along the normal, in mesh units (default: 1e-4 x bounding-box "
+                    "diagonal)");
+    sub->add_option("--back-faces", o->back_faces,
+                    "occlude: both sides of a triangle block rays; ignore: rays pass through triangles seen from "
+                    "behind (open, single-sided meshes)")
+        ->capture_default_str();
+    sub->add_flag("--normalize", o->normalize,
+                  "Divide AO and A by their unoccluded sums (an open vertex gets exactly 1 with any rule)");
+    sub->add_option("--bits", o->bits, "Also write the bit-packed visibility per rule direction to this file");
+    sub->add_option("--preview", o->preview, "Also write a preview image (.png or .exr) shaded by the baked AO");
+    sub->add_option("--preview-size", o->preview_size, "Preview size WxH in pixels")->capture_default_str();
+    sub->add_option("--preview-azimuth", o->azimuth_deg, "Preview camera azimuth around +y, degrees")
+        ->capture_default_str();
+    sub->add_option("--preview-elevation", o->elevation_deg, "Preview camera elevation, degrees")
+        ->capture_default_str();
+    add_json_flag(*sub, o->json);
+    sub->callback([o] { run(*o); });
+}
+
+SKYBAKE_CLI_GROUP_COMMAND("ao", add_ao_bake)
+
+} // namespace skybake::cli

@@ -1,0 +1,96 @@
+// Preview of a baked mesh: primary rays from a pinhole camera (Embree), each
+// hit shaded by the baked per-vertex AO interpolated with the hit's
+// barycentrics, as a vertex-colour viewer would show it.
+#include <cmath>
+
+#include <fmt/format.h>
+#include <glm/geometric.hpp>
+
+#include "skybake/bake.h"
+#include "skybake/error.h"
+
+namespace skybake {
+
+Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
+    validate_mesh(mesh, "mesh");
+    const VertexAttribute* ao = mesh.find_attribute("ao");
+    if (!ao || ao->components != 1)
+        throw Error("the mesh has no baked 'ao' attribute to preview; bake it first", "mesh");
+    if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
+        throw Error(fmt::format("preview size {}x{} is out of range; use 1 to 16384 pixels per side", o.width, o.height),
+                    "--preview-size");
+    if (o.samples < 1 || o.samples > 8)
+        throw Error(fmt::format("{} samples per pixel axis is out of range; use 1 to 8", o.samples));
+    if (!(o.fov_y_deg > 1.0f && o.fov_y_deg < 170.0f))
+        throw Error(fmt::format("field of view {} degrees is out of range; use 1 to 170", o.fov_y_deg));
+
+    const auto backend = make_visibility_backend("embree");
+    backend->set_mesh(mesh, BackFaces::Occlude);
+
+    // Camera framing the bounding sphere of the bounding box, y up.
+    const Bounds b = compute_bounds(mesh);
+    const glm::vec3 centre = 0.5f * (b.min + b.max);
+    const float radius = std::max(0.5f * b.diagonal(), 1e-20f);
+    const float deg = 3.14159265358979f / 180.0f;
+    const float az = o.azimuth_deg * deg, el = o.elevation_deg * deg;
+    const glm::vec3 to_eye(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
+    const float half = 0.5f * o.fov_y_deg * deg;
+    const float aspect = float(o.width) / float(o.height);
+    const float fit = std::min(std::sin(half), std::sin(std::atan(std::tan(half) * aspect)));
+    const glm::vec3 eye = centre + to_eye * (radius / fit * 1.02f);
+    const glm::vec3 forward = -to_eye;
+    glm::vec3 up_hint(0.0f, 1.0f, 0.0f);
+    if (std::abs(glm::dot(forward, up_hint)) > 0.999f)
+        up_hint = glm::vec3(0.0f, 0.0f, -1.0f);
+    const glm::vec3 right = glm::normalize(glm::cross(forward, up_hint));
+    const glm::vec3 up = glm::cross(right, forward);
+    const float th = std::tan(half);
+
+    const glm::vec3 background(0.035f, 0.045f, 0.065f);
+    Image img(o.width, o.height);
+    const int s = o.samples;
+    const std::size_t row_rays = std::size_t(o.width) * std::size_t(s * s);
+    const int rows_per_block = 32;
+    std::vector<Ray> rays;
+    std::vector<RayHit> hits;
+    for (int y0 = 0; y0 < o.height; y0 += rows_per_block) {
+        const int y1 = std::min(o.height, y0 + rows_per_block);
+        rays.clear();
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < o.width; ++x)
+                for (int sy = 0; sy < s; ++sy)
+                    for (int sx = 0; sx < s; ++sx) {
+                        const float px = (float(x) + (float(sx) + 0.5f) / float(s)) / float(o.width);
+                        const float py = (float(y) + (float(sy) + 0.5f) / float(s)) / float(o.height);
+                        const float cx = (2.0f * px - 1.0f) * th * aspect, cy = (1.0f - 2.0f * py) * th;
+                        rays.push_back({eye, 0.0f, glm::normalize(forward + cx * right + cy * up),
+                                        std::numeric_limits<float>::infinity()});
+                    }
+        hits.resize(rays.size());
+        backend->intersect(rays, hits);
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < o.width; ++x) {
+                glm::vec3 sum(0.0f);
+                const std::size_t first = std::size_t(y - y0) * row_rays + std::size_t(x) * std::size_t(s * s);
+                for (std::size_t i = first; i < first + std::size_t(s * s); ++i) {
+                    const RayHit& h = hits[i];
+                    if (h.triangle == kNoHit) {
+                        sum += background;
+                        continue;
+                    }
+                    const std::uint32_t* tri = &mesh.indices[3 * std::size_t(h.triangle)];
+                    const float a = (1.0f - h.u - h.v) * ao->values[tri[0]] + h.u * ao->values[tri[1]] +
+                                    h.v * ao->values[tri[2]];
+                    sum += glm::vec3(a);
+                }
+                sum /= float(s * s);
+                float* p = img.pixel(x, y);
+                p[0] = sum.x;
+                p[1] = sum.y;
+                p[2] = sum.z;
+            }
+    }
+    return img;
+}
+
+} // namespace skybake

@@ -1,0 +1,55 @@
+// Internal: what every backend's bake() shares (input checks, the rule in
+// single precision, per-vertex frames, writing one vertex's results).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+#include <glm/mat3x3.hpp>
+#include <glm/vec3.hpp>
+
+#include "skybake/mesh.h"
+#include "skybake/sphere.h"
+#include "skybake/visibility.h"
+
+namespace skybake::visibility {
+
+struct BakeSetup {
+    std::vector<glm::vec3> points; // rule directions, single precision
+    std::vector<float> weights;
+    std::uint32_t directions = 0;
+    std::uint32_t words = 0; // per vertex
+    bool rotate = false;
+    std::uint64_t rotation_seed = 0;
+    bool normalize = false;
+    bool store_bits = false;
+    float offset = 0.0f;   // mesh units
+    float t_max = 0.0f;    // mesh units (may be infinite)
+    std::vector<glm::vec3> normals; // unit
+};
+
+// Per-vertex ray frame.
+struct VertexFrame {
+    glm::vec3 origin{0.0f};
+    glm::vec3 normal{0.0f, 0.0f, 1.0f};
+    glm::mat3 rotation{1.0f};
+};
+
+// Checks the inputs (throws skybake::Error with a message for the user), fills
+// the setup and sizes every array of `out`.
+BakeSetup prepare_bake(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options, BakeOutputs& out);
+
+VertexFrame vertex_frame(const BakeSetup& setup, const Mesh& mesh, std::uint32_t vertex);
+
+// Reduces one vertex's words and stores ao, shading, bent normal (and the words
+// when store_bits). Thread-safe for distinct vertices.
+void finish_vertex(const BakeSetup& setup, const VertexFrame& frame, std::uint32_t vertex, const std::uint32_t* words,
+                   BakeOutputs& out, std::atomic<std::uint64_t>& clamped);
+
+// Orders rule directions so that consecutive ones are close on the sphere
+// (Morton order of the octahedral map): packets of consecutive rays from one
+// vertex are then coherent.
+std::vector<std::uint32_t> coherent_direction_order(const std::vector<glm::vec3>& points);
+
+} // namespace skybake::visibility

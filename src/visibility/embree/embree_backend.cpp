@@ -1,0 +1,301 @@
+// Embree 3 visibility backend.
+//
+// Wald I., Woop S., Benthin C., Johnson G. S., Ernst M. Embree: a kernel
+// framework for efficient CPU ray tracing. ACM TOG 33(4), SIGGRAPH 2014.
+//
+// The bake casts, for each vertex, the rule directions above its horizon from
+// one origin. Directions are visited in a fixed coherent order (Morton order of
+// the octahedral map, bake_common.h) and issued as 16-ray packets
+// (rtcOccluded16, coherent context flag): rays of one packet share the origin and
+// point into a small patch of the sphere, so they traverse the BVH together.
+// Vertices are spread over TBB tasks; each vertex's result depends on that vertex
+// alone, so the output does not depend on the thread count.
+#include "visibility/embree/embree_backend.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cassert>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+#include <glm/geometric.hpp>
+
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "skybake/error.h"
+#include "skybake/mesh.h"
+#include "skybake/sphere.h"
+#include "visibility/bake_common.h"
+#include "visibility/shading_hd.h"
+
+namespace skybake::visibility {
+
+namespace {
+
+constexpr int kPacket = 16;
+
+const char* error_name(RTCError code) {
+    switch (code) {
+    case RTC_ERROR_NONE: return "no error";
+    case RTC_ERROR_INVALID_ARGUMENT: return "invalid argument";
+    case RTC_ERROR_INVALID_OPERATION: return "invalid operation";
+    case RTC_ERROR_OUT_OF_MEMORY: return "out of memory";
+    case RTC_ERROR_UNSUPPORTED_CPU: return "unsupported CPU";
+    case RTC_ERROR_CANCELLED: return "cancelled";
+    default: return "unknown error";
+    }
+}
+
+RTCIntersectContext coherent_context() {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    return ctx;
+}
+
+RTCIntersectContext incoherent_context() {
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    return ctx;
+}
+
+void set_lane(RTCRay16& r, int lane, const glm::vec3& o, const glm::vec3& d, float t_min, float t_max) {
+    r.org_x[lane] = o.x;
+    r.org_y[lane] = o.y;
+    r.org_z[lane] = o.z;
+    r.tnear[lane] = t_min;
+    r.dir_x[lane] = d.x;
+    r.dir_y[lane] = d.y;
+    r.dir_z[lane] = d.z;
+    r.time[lane] = 0.0f;
+    r.tfar[lane] = t_max;
+    r.mask[lane] = 0xffffffffu;
+    r.id[lane] = unsigned(lane);
+    r.flags[lane] = 0;
+}
+
+} // namespace
+
+EmbreeBackend::EmbreeBackend() {
+    device_ = rtcNewDevice("verbose=0");
+    if (!device_)
+        throw Error(fmt::format("cannot start Embree: {}", error_name(rtcGetDeviceError(nullptr))), "embree");
+    rtcSetDeviceErrorFunction(device_, &EmbreeBackend::error_callback, this);
+}
+
+EmbreeBackend::~EmbreeBackend() {
+    if (scene_)
+        rtcReleaseScene(scene_);
+    if (device_)
+        rtcReleaseDevice(device_);
+}
+
+void EmbreeBackend::error_callback(void* self, RTCError code, const char* message) {
+    auto* b = static_cast<EmbreeBackend*>(self);
+    std::lock_guard lock(b->error_mutex_);
+    b->last_error_ = fmt::format("{}{}{}", error_name(code), message && *message ? ": " : "", message ? message : "");
+}
+
+void EmbreeBackend::check(const char* what) {
+    const RTCError code = rtcGetDeviceError(device_);
+    if (code == RTC_ERROR_NONE)
+        return;
+    std::string detail;
+    {
+        std::lock_guard lock(error_mutex_);
+        detail = last_error_.empty() ? error_name(code) : last_error_;
+    }
+    if (code == RTC_ERROR_OUT_OF_MEMORY)
+        throw Error(fmt::format("Embree ran out of memory while {}; use a smaller mesh or a machine with more memory",
+                                what),
+                    "embree");
+    throw Error(fmt::format("Embree failed while {}: {}", what, detail), "embree");
+}
+
+// Occlusion and intersection filter for BackFaces::Ignore: a candidate hit on
+// a triangle seen from behind (direction along its front normal) is rejected.
+void EmbreeBackend::back_face_filter(const RTCFilterFunctionNArguments* args) {
+    const auto* self = static_cast<const EmbreeBackend*>(args->geometryUserPtr);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1)
+            continue;
+        const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+        const glm::vec3 d(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                          RTCRayN_dir_z(args->ray, args->N, i));
+        if (glm::dot(self->face_normals_[prim], d) > 0.0f)
+            args->valid[i] = 0;
+    }
+}
+
+void EmbreeBackend::set_mesh(const Mesh& mesh, BackFaces back_faces) {
+    validate_mesh(mesh, "mesh");
+    if (scene_) {
+        rtcReleaseScene(scene_);
+        scene_ = nullptr;
+    }
+    const std::size_t nv = mesh.vertex_count(), nt = mesh.triangle_count();
+    RTCScene scene = rtcNewScene(device_);
+    rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_HIGH);
+    RTCGeometry geom = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
+    auto* vb = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), nv));
+    auto* ib = static_cast<unsigned*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned), nt));
+    if (!vb || !ib) {
+        rtcReleaseGeometry(geom);
+        rtcReleaseScene(scene);
+        check("allocating the mesh buffers");
+        throw Error("Embree could not allocate the mesh buffers", "embree");
+    }
+    for (std::size_t v = 0; v < nv; ++v) {
+        vb[3 * v] = mesh.positions[v].x;
+        vb[3 * v + 1] = mesh.positions[v].y;
+        vb[3 * v + 2] = mesh.positions[v].z;
+    }
+    std::copy(mesh.indices.begin(), mesh.indices.end(), ib);
+    face_normals_.clear();
+    if (back_faces == BackFaces::Ignore) {
+        face_normals_.resize(nt);
+        for (std::size_t t = 0; t < nt; ++t) {
+            const glm::vec3 p0 = mesh.positions[mesh.indices[3 * t]];
+            const glm::vec3 p1 = mesh.positions[mesh.indices[3 * t + 1]];
+            const glm::vec3 p2 = mesh.positions[mesh.indices[3 * t + 2]];
+            face_normals_[t] = glm::cross(p1 - p0, p2 - p0);
+        }
+        rtcSetGeometryUserData(geom, this);
+        rtcSetGeometryOccludedFilterFunction(geom, &EmbreeBackend::back_face_filter);
+        rtcSetGeometryIntersectFilterFunction(geom, &EmbreeBackend::back_face_filter);
+    }
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene, geom);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(scene);
+    if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) {
+        rtcReleaseScene(scene);
+        check(fmt::format("building the BVH of {} triangles", nt).c_str());
+    }
+    scene_ = scene;
+}
+
+void EmbreeBackend::occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const {
+    assert(scene_ && rays.size() == occluded.size());
+    const std::size_t packets = (rays.size() + kPacket - 1) / kPacket;
+    parallel_for(packets, 64, [&](std::size_t b, std::size_t e) {
+        RTCIntersectContext ctx = incoherent_context();
+        alignas(64) RTCRay16 r;
+        alignas(64) int valid[kPacket];
+        for (std::size_t p = b; p < e; ++p) {
+            const std::size_t first = p * kPacket;
+            const int n = int(std::min<std::size_t>(kPacket, rays.size() - first));
+            for (int l = 0; l < kPacket; ++l) {
+                valid[l] = l < n ? -1 : 0;
+                if (l < n) {
+                    const Ray& ray = rays[first + std::size_t(l)];
+                    set_lane(r, l, ray.origin, ray.direction, ray.t_min, ray.t_max);
+                }
+            }
+            rtcOccluded16(valid, scene_, &ctx, &r);
+            for (int l = 0; l < n; ++l)
+                occluded[first + std::size_t(l)] = r.tfar[l] == -std::numeric_limits<float>::infinity() ? 1 : 0;
+        }
+    });
+}
+
+void EmbreeBackend::intersect(std::span<const Ray> rays, std::span<RayHit> hits) const {
+    assert(scene_ && rays.size() == hits.size());
+    const std::size_t packets = (rays.size() + kPacket - 1) / kPacket;
+    parallel_for(packets, 16, [&](std::size_t b, std::size_t e) {
+        RTCIntersectContext ctx = incoherent_context();
+        alignas(64) RTCRayHit16 rh;
+        alignas(64) int valid[kPacket];
+        for (std::size_t p = b; p < e; ++p) {
+            const std::size_t first = p * kPacket;
+            const int n = int(std::min<std::size_t>(kPacket, rays.size() - first));
+            for (int l = 0; l < kPacket; ++l) {
+                valid[l] = l < n ? -1 : 0;
+                if (l < n) {
+                    const Ray& ray = rays[first + std::size_t(l)];
+                    set_lane(rh.ray, l, ray.origin, ray.direction, ray.t_min, ray.t_max);
+                    rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+                    rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+                }
+            }
+            rtcIntersect16(valid, scene_, &ctx, &rh);
+            for (int l = 0; l < n; ++l) {
+                RayHit& h = hits[first + std::size_t(l)];
+                if (rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID) {
+                    h = RayHit{};
+                } else {
+                    h.t = rh.ray.tfar[l];
+                    h.triangle = rh.hit.primID[l];
+                    h.u = rh.hit.u[l];
+                    h.v = rh.hit.v[l];
+                }
+            }
+        }
+    });
+}
+
+void EmbreeBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options, BakeOutputs& out) {
+    const BakeSetup s = prepare_bake(mesh, rule, options, out);
+    const auto t0 = std::chrono::steady_clock::now();
+    set_mesh(mesh, options.back_faces);
+    const auto t1 = std::chrono::steady_clock::now();
+    out.build_seconds = std::chrono::duration<double>(t1 - t0).count();
+
+    const std::vector<std::uint32_t> order = coherent_direction_order(s.points);
+    std::vector<glm::vec3> sorted_points(s.directions);
+    for (std::uint32_t j = 0; j < s.directions; ++j)
+        sorted_points[j] = s.points[order[j]];
+
+    const std::size_t n = mesh.vertex_count();
+    Progress progress("ao", n);
+    std::atomic<std::uint64_t> rays{0}, clamped{0};
+    parallel_for(n, 4, [&](std::size_t b, std::size_t e) {
+        RTCIntersectContext ctx = coherent_context();
+        alignas(64) RTCRay16 r;
+        alignas(64) int valid[kPacket];
+        std::uint32_t lane_k[kPacket];
+        std::vector<std::uint32_t> words(s.words);
+        std::uint64_t traced = 0;
+        for (std::size_t v = b; v < e; ++v) {
+            const VertexFrame f = vertex_frame(s, mesh, std::uint32_t(v));
+            std::fill(words.begin(), words.end(), 0u);
+            int lanes = 0;
+            const auto flush = [&] {
+                for (int l = lanes; l < kPacket; ++l)
+                    valid[l] = 0;
+                rtcOccluded16(valid, scene_, &ctx, &r);
+                for (int l = 0; l < lanes; ++l)
+                    if (r.tfar[l] != -std::numeric_limits<float>::infinity())
+                        set_bit(words.data(), lane_k[l]);
+                traced += std::uint64_t(lanes);
+                lanes = 0;
+            };
+            for (std::uint32_t j = 0; j < s.directions; ++j) {
+                const glm::vec3 x = rule_direction(f.rotation, s.rotate, sorted_points[j]);
+                if (!(glm::dot(f.normal, x) > 0.0f))
+                    continue;
+                set_lane(r, lanes, f.origin, x, 0.0f, s.t_max);
+                valid[lanes] = -1;
+                lane_k[lanes] = order[j];
+                if (++lanes == kPacket)
+                    flush();
+            }
+            if (lanes > 0)
+                flush();
+            finish_vertex(s, f, std::uint32_t(v), words.data(), out, clamped);
+        }
+        rays += traced;
+        progress.advance(e - b);
+    });
+    progress.finish();
+    out.rays = rays.load();
+    out.clamped_vertices = clamped.load();
+    out.trace_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+}
+
+} // namespace skybake::visibility
