@@ -151,7 +151,7 @@ void compare_sample_counts(const std::filesystem::path& dir) {
     tm.curve = ToneCurve::Clamp;
     save_png(dir / "neural_samples_800k_vs_8m.png",
              draw_line_chart(series, "paper topology on earth: 800,000 against 8,000,000 samples",
-                             "epoch (40 Adam, then LM iterations)", "RMS error of the outputs"),
+                             "epoch (60 Adam, then LM iterations)", "RMS error of the outputs"),
              tm);
 }
 

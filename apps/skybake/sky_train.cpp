@@ -25,7 +25,7 @@ void add_sky_train(CLI::App& group) {
     sub->add_option("--brightness", o->brightness,
                     "Brightness output M: log (default; relative accuracy) or seed (linear, as printed)");
     sub->add_option("--log-range", o->log_range_decades, "Decades of N/max{N} the log brightness covers (default 6)");
-    sub->add_option("--epochs", o->t.adam_epochs, "Adam epochs (default 40)");
+    sub->add_option("--epochs", o->t.adam_epochs, "Adam epochs (default 60)");
     sub->add_option("--lm-iterations", o->t.lm_iterations, "Levenberg-Marquardt iterations after Adam (default 30)");
     sub->add_option("--lm-samples", o->t.lm_samples, "Samples in the LM least squares (default: automatic)");
     sub->add_option("--batch", o->t.batch, "Adam mini-batch (default 1024)");

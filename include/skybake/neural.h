@@ -162,7 +162,7 @@ struct NeuralTrainOptions {
     std::size_t heldout_samples = 20000;     // held-out samples for the learning curve
     std::size_t max_n_samples = 100000;      // samples for max{N} (the seed's 100,000)
     std::uint64_t seed = 1;
-    int adam_epochs = 40;
+    int adam_epochs = 60;
     std::size_t batch = 1024;                // Adam mini-batch
     double learning_rate = 0.02;             // Adam, first epoch
     double learning_rate_final = 0.0005;     // Adam, last epoch (exponential decay between)

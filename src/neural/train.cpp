@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cmath>
 #include <numeric>
+#include <optional>
 
 #include <Eigen/Cholesky>
 #include <fmt/format.h>
@@ -261,7 +262,9 @@ NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, s
     net.weights = initial_weights(lay, stream_seed(o.seed, 3));
     const std::size_t P = net.weights.size();
 
-    Progress progress("train", std::uint64_t(o.adam_epochs + o.lm_iterations));
+    std::optional<Progress> progress;
+    if (o.progress)
+        progress.emplace("train", std::uint64_t(o.adam_epochs + o.lm_iterations));
     auto record = [&](int epoch, const char* phase, double train_rms) {
         const ErrorPair h = evaluate_set(lay, net, held);
         net.training.train_rms = train_rms;
@@ -269,7 +272,8 @@ NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, s
         net.training.heldout_mean_relative = h.mean_relative;
         if (curve)
             curve->push_back({epoch, phase, train_rms, h.rms, h.mean_relative, elapsed()});
-        progress.advance();
+        if (progress)
+            progress->advance();
     };
 
     // --- Adam --------------------------------------------------------------------
@@ -353,7 +357,8 @@ NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, s
             train_loss += subnet_loss(lay, net.weights, s, train, train.size());
         record(o.adam_epochs + lm_run, "lm", std::sqrt(train_loss / std::max(1.0, train.mask_count)));
     }
-    progress.finish();
+    if (progress)
+        progress->finish();
     if (o.adam_epochs + lm_run == 0) { // nothing trained: still fill in the summary
         const ErrorPair h = evaluate_set(lay, net, held);
         net.training.train_rms = evaluate_set(lay, net, train).rms;
