@@ -11,6 +11,7 @@
 #include "skybake/bake.h"
 #include "skybake/error.h"
 #include "sphere/random_rotation.h"
+#include "visibility/bake_common.h"
 #include "visibility/shading_hd.h"
 
 namespace skybake {
@@ -76,8 +77,9 @@ ShadingCoefficients shading_from_bits(std::span<const std::uint32_t> words, cons
     if (!(len > 0.0f) || !std::isfinite(len))
         throw Error("the normal must be a non-zero finite vector");
     const glm::vec3 n = normal / len;
-    const auto s = visibility::shading_from_bits(words.data(), points.data(), weights.data(), k, n, rotation,
-                                                 rule.rotate_per_vertex, normalize);
+    const std::vector<std::uint32_t> order = visibility::coherent_direction_order(points);
+    const auto s = visibility::shading_from_bits(words.data(), points.data(), weights.data(), order.data(), k, n,
+                                                 rotation, rule.rotate_per_vertex, normalize);
     return {s.ao, s.shading, s.bent_normal};
 }
 

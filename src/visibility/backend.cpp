@@ -79,8 +79,10 @@ void VisibilityBackend::bake(const Mesh& mesh, const SphereRule& rule, const Bak
             batch.clear();
             index.clear();
             for (std::uint32_t k = 0; k < s.directions; ++k) {
-                const glm::vec3 x = visibility::rule_direction(frame.rotation, s.rotate, s.points[k]);
-                if (glm::dot(frame.normal, x) > 0.0f) {
+                glm::vec3 x;
+                float c;
+                visibility::vertex_direction(s.points[k], frame.rotation, s.rotate, frame.normal, x, c);
+                if (c > 0.0f) {
                     batch.push_back({frame.origin, 0.0f, x, s.t_max});
                     index.push_back(k);
                 }
@@ -131,6 +133,13 @@ BakeSetup prepare_bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
     s.points = rule.points_f32();
     s.weights = rule.weights_f32();
     s.directions = std::uint32_t(rule.size());
+    s.order = coherent_direction_order(s.points);
+    s.sorted_points.resize(s.directions);
+    s.sorted_weights.assign(padded_directions(s.directions), 0.0f);
+    for (std::uint32_t j = 0; j < s.directions; ++j) {
+        s.sorted_points[j] = s.points[s.order[j]];
+        s.sorted_weights[j] = s.weights[s.order[j]];
+    }
     s.words = words_for_directions(s.directions);
     s.rotate = rule.rotate_per_vertex;
     s.rotation_seed = rule.rotation_seed;
@@ -183,8 +192,13 @@ VertexFrame vertex_frame(const BakeSetup& s, const Mesh& mesh, std::uint32_t ver
 
 void finish_vertex(const BakeSetup& s, const VertexFrame& f, std::uint32_t vertex, const std::uint32_t* words,
                    BakeOutputs& out, std::atomic<std::uint64_t>& clamped) {
-    const Shading r = shading_from_bits(words, s.points.data(), s.weights.data(), s.directions, f.normal, f.rotation,
-                                        s.rotate, s.normalize);
+    const Shading r = shading_from_bits(words, s.points.data(), s.weights.data(), s.order.data(), s.directions,
+                                        f.normal, f.rotation, s.rotate, s.normalize);
+    store_vertex(s, vertex, r, words, out, clamped);
+}
+
+void store_vertex(const BakeSetup& s, std::uint32_t vertex, const Shading& r, const std::uint32_t* words,
+                  BakeOutputs& out, std::atomic<std::uint64_t>& clamped) {
     out.ao[vertex] = r.ao;
     out.shading[vertex] = r.shading;
     out.bent_normal[vertex] = r.bent_normal;

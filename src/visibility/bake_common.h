@@ -12,12 +12,18 @@
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 #include "skybake/visibility.h"
+#include "visibility/shading_hd.h"
 
 namespace skybake::visibility {
 
 struct BakeSetup {
-    std::vector<glm::vec3> points; // rule directions, single precision
+    std::vector<glm::vec3> points; // rule directions, single precision, rule order k
     std::vector<float> weights;
+    // Visiting order (coherent_direction_order) and the rule in that order,
+    // weights zero-padded to padded_directions(K) entries.
+    std::vector<std::uint32_t> order;
+    std::vector<glm::vec3> sorted_points;
+    std::vector<float> sorted_weights;
     std::uint32_t directions = 0;
     std::uint32_t words = 0; // per vertex
     bool rotate = false;
@@ -46,6 +52,9 @@ VertexFrame vertex_frame(const BakeSetup& setup, const Mesh& mesh, std::uint32_t
 // when store_bits). Thread-safe for distinct vertices.
 void finish_vertex(const BakeSetup& setup, const VertexFrame& frame, std::uint32_t vertex, const std::uint32_t* words,
                    BakeOutputs& out, std::atomic<std::uint64_t>& clamped);
+// Stores one vertex's reduced result (and its words when store_bits).
+void store_vertex(const BakeSetup& setup, std::uint32_t vertex, const Shading& result, const std::uint32_t* words,
+                  BakeOutputs& out, std::atomic<std::uint64_t>& clamped);
 
 // Orders rule directions so that consecutive ones are close on the sphere
 // (Morton order of the octahedral map): packets of consecutive rays from one

@@ -46,6 +46,14 @@ SKYBAKE_HD_INLINE glm::vec3 ray_origin(const glm::vec3& position, const glm::vec
 }
 
 // [SECTION] Reduction -------------------------------------------------------------------
+//
+// The directions are visited in one fixed order, the rule's coherent order
+// (order[j] = k, see coherent_direction_order() in bake_common.h); the j-th one
+// goes to partial sum j mod kReduceLanes, and the partials are added in lane
+// order at the end. Every backend follows this order, so all of them get the
+// same bits of float from the same visibility, and CPU loops vectorise.
+
+inline constexpr std::uint32_t kReduceLanes = 8;
 
 struct ShadingSums {
     float ao = 0.0f;      // Σ w 4 c V
@@ -55,16 +63,42 @@ struct ShadingSums {
     glm::vec3 bent{0.0f}; // Σ w c V x
 };
 
-// One direction x (unit, world space) with weight w and cos_n = n·x > 0.
-SKYBAKE_HD_INLINE void add_direction(ShadingSums& s, float w, float cos_n, const glm::vec3& x, bool visible) {
-    const float wc = w * cos_n;
-    s.ao_open += 4.0f * wc;
-    s.a_open += 2.0f * w;
-    if (visible) {
-        s.ao += 4.0f * wc;
-        s.a += 2.0f * w;
-        s.bent += wc * x;
+struct ShadingPartials {
+    float ao[kReduceLanes] = {}, ao_open[kReduceLanes] = {}, a[kReduceLanes] = {}, a_open[kReduceLanes] = {};
+    float bx[kReduceLanes] = {}, by[kReduceLanes] = {}, bz[kReduceLanes] = {};
+};
+
+// One direction (x, y, z) (unit, world space) with weight w, cos_n = n·x and
+// visible = 1 or 0, into partial `lane`. A direction with cos_n ≤ 0 (below the
+// horizon) adds nothing, an invisible one adds to the unoccluded sums only.
+// Written without branches; adding the zero terms leaves the sums unchanged.
+SKYBAKE_HD_INLINE void add_direction(ShadingPartials& p, std::uint32_t lane, float w, float cos_n, float x, float y,
+                                     float z, float visible) {
+    const float up = float(cos_n > 0.0f);
+    const float seen = visible * up;
+    const float wc = w * cos_n * up;
+    const float ao = 4.0f * wc, a = 2.0f * w * up, b = wc * seen;
+    p.ao_open[lane] += ao;
+    p.a_open[lane] += a;
+    p.ao[lane] += ao * seen;
+    p.a[lane] += a * seen;
+    p.bx[lane] += b * x;
+    p.by[lane] += b * y;
+    p.bz[lane] += b * z;
+}
+
+SKYBAKE_HD_INLINE ShadingSums combine_partials(const ShadingPartials& p) {
+    ShadingSums s;
+    for (std::uint32_t l = 0; l < kReduceLanes; ++l) {
+        s.ao += p.ao[l];
+        s.ao_open += p.ao_open[l];
+        s.a += p.a[l];
+        s.a_open += p.a_open[l];
+        s.bent.x += p.bx[l];
+        s.bent.y += p.by[l];
+        s.bent.z += p.bz[l];
     }
+    return s;
 }
 
 struct Shading {
@@ -97,20 +131,52 @@ SKYBAKE_HD_INLINE Shading finish_shading(const ShadingSums& s, const glm::vec3& 
     return r;
 }
 
-// The whole reduction for one vertex, from its visibility words (direction
-// order k = 0 ... K−1). points/weights: the rule in single precision; normal:
-// unit; rotation: the vertex's rule rotation (ignored unless rotate).
+// Direction k of a vertex and its cosine to the normal: the one place where
+// both are computed, so that every caller gets the same bits of float.
+SKYBAKE_HD_INLINE void vertex_direction(const glm::vec3& point, const glm::mat3& rotation, bool rotate,
+                                        const glm::vec3& normal, glm::vec3& x, float& cos_n) {
+    x = rule_direction(rotation, rotate, point);
+    cos_n = glm::dot(normal, x);
+}
+
+// The whole reduction for one vertex, from its visibility words (bit k for rule
+// direction k). points/weights: the rule in single precision; order: the
+// visiting order (a permutation of 0 ... K−1); normal: unit; rotation: the
+// vertex's rule rotation (ignored unless rotate).
 SKYBAKE_HD_INLINE Shading shading_from_bits(const std::uint32_t* words, const glm::vec3* points, const float* weights,
-                                            std::uint32_t directions, const glm::vec3& normal,
-                                            const glm::mat3& rotation, bool rotate, bool normalize) {
-    ShadingSums s;
-    for (std::uint32_t k = 0; k < directions; ++k) {
-        const glm::vec3 x = rule_direction(rotation, rotate, points[k]);
-        const float c = glm::dot(normal, x);
-        if (c > 0.0f)
-            add_direction(s, weights[k], c, x, get_bit(words, k));
-    }
-    return finish_shading(s, normal, normalize);
+                                            const std::uint32_t* order, std::uint32_t directions,
+                                            const glm::vec3& normal, const glm::mat3& rotation, bool rotate,
+                                            bool normalize) {
+    ShadingPartials p;
+    for (std::uint32_t j0 = 0; j0 < directions; j0 += kReduceLanes)
+        for (std::uint32_t l = 0; l < kReduceLanes && j0 + l < directions; ++l) {
+            const std::uint32_t k = order[j0 + l];
+            glm::vec3 x;
+            float c;
+            vertex_direction(points[k], rotation, rotate, normal, x, c);
+            add_direction(p, l, weights[k], c, x.x, x.y, x.z, get_bit(words, k) ? 1.0f : 0.0f);
+        }
+    return finish_shading(combine_partials(p), normal, normalize);
+}
+
+// Same, from arrays in visiting order already filled by vertex_direction()
+// (x, y, z, cos_n of the j-th direction), its weight and visible[j] = 1 or 0,
+// each padded with zeros to a multiple of kReduceLanes entries: the same
+// arithmetic in the same order, so the same result.
+SKYBAKE_HD_INLINE Shading shading_from_arrays(const float* x, const float* y, const float* z, const float* cos_n,
+                                              const float* weights, const float* visible, std::uint32_t padded,
+                                              const glm::vec3& normal, bool normalize) {
+    ShadingPartials p;
+    for (std::uint32_t j0 = 0; j0 < padded; j0 += kReduceLanes)
+        for (std::uint32_t l = 0; l < kReduceLanes; ++l) {
+            const std::uint32_t j = j0 + l;
+            add_direction(p, l, weights[j], cos_n[j], x[j], y[j], z[j], visible[j]);
+        }
+    return finish_shading(combine_partials(p), normal, normalize);
+}
+
+SKYBAKE_HD_INLINE std::uint32_t padded_directions(std::uint32_t directions) {
+    return (directions + kReduceLanes - 1) / kReduceLanes * kReduceLanes;
 }
 
 } // namespace skybake::visibility

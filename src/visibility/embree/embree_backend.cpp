@@ -246,48 +246,67 @@ void EmbreeBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOpt
     const auto t1 = std::chrono::steady_clock::now();
     out.build_seconds = std::chrono::duration<double>(t1 - t0).count();
 
-    const std::vector<std::uint32_t> order = coherent_direction_order(s.points);
-    std::vector<glm::vec3> sorted_points(s.directions);
-    for (std::uint32_t j = 0; j < s.directions; ++j)
-        sorted_points[j] = s.points[order[j]];
-
+    const std::uint32_t padded = padded_directions(s.directions);
     const std::size_t n = mesh.vertex_count();
+    const float inf = std::numeric_limits<float>::infinity();
     Progress progress("ao", n);
     std::atomic<std::uint64_t> rays{0}, clamped{0};
     parallel_for(n, 4, [&](std::size_t b, std::size_t e) {
         RTCIntersectContext ctx = coherent_context();
         alignas(64) RTCRay16 r;
         alignas(64) int valid[kPacket];
-        std::uint32_t lane_k[kPacket];
         std::vector<std::uint32_t> words(s.words);
+        // Per-direction scratch in visiting order, structure of arrays,
+        // zero-padded to `padded`.
+        std::vector<float> xs(padded, 0.0f), ys(padded, 0.0f), zs(padded, 0.0f), cs(padded, 0.0f), vis(padded);
+        std::vector<std::uint32_t> sel(s.directions);
         std::uint64_t traced = 0;
         for (std::size_t v = b; v < e; ++v) {
             const VertexFrame f = vertex_frame(s, mesh, std::uint32_t(v));
-            std::fill(words.begin(), words.end(), 0u);
-            int lanes = 0;
-            const auto flush = [&] {
-                for (int l = lanes; l < kPacket; ++l)
-                    valid[l] = 0;
-                rtcOccluded16(valid, scene_, &ctx, &r);
-                for (int l = 0; l < lanes; ++l)
-                    if (r.tfar[l] != -std::numeric_limits<float>::infinity())
-                        set_bit(words.data(), lane_k[l]);
-                traced += std::uint64_t(lanes);
-                lanes = 0;
-            };
+            // Directions and cosines once per vertex; the reduction reuses them.
             for (std::uint32_t j = 0; j < s.directions; ++j) {
-                const glm::vec3 x = rule_direction(f.rotation, s.rotate, sorted_points[j]);
-                if (!(glm::dot(f.normal, x) > 0.0f))
-                    continue;
-                set_lane(r, lanes, f.origin, x, 0.0f, s.t_max);
-                valid[lanes] = -1;
-                lane_k[lanes] = order[j];
-                if (++lanes == kPacket)
-                    flush();
+                glm::vec3 x;
+                vertex_direction(s.sorted_points[j], f.rotation, s.rotate, f.normal, x, cs[j]);
+                xs[j] = x.x;
+                ys[j] = x.y;
+                zs[j] = x.z;
             }
-            if (lanes > 0)
-                flush();
-            finish_vertex(s, f, std::uint32_t(v), words.data(), out, clamped);
+            std::fill(words.begin(), words.end(), 0u);
+            std::fill(vis.begin(), vis.end(), 0.0f);
+            // All rays of the vertex share origin and interval: set those lanes once.
+            for (int l = 0; l < kPacket; ++l)
+                set_lane(r, l, f.origin, f.normal, 0.0f, s.t_max);
+            // Branch-free selection of the directions above the horizon ...
+            std::uint32_t m = 0;
+            for (std::uint32_t j = 0; j < s.directions; ++j) {
+                sel[m] = j;
+                m += std::uint32_t(cs[j] > 0.0f);
+            }
+            // ... traced 16 at a time. Occluded lanes come back with tfar = -inf.
+            for (std::uint32_t base = 0; base < m; base += kPacket) {
+                const int count = int(std::min<std::uint32_t>(kPacket, m - base));
+                const std::uint32_t* lane_j = sel.data() + base;
+                for (int l = 0; l < kPacket; ++l) {
+                    valid[l] = l < count ? -1 : 0;
+                    r.tfar[l] = s.t_max;
+                }
+                for (int l = 0; l < count; ++l) {
+                    r.dir_x[l] = xs[lane_j[l]];
+                    r.dir_y[l] = ys[lane_j[l]];
+                    r.dir_z[l] = zs[lane_j[l]];
+                }
+                rtcOccluded16(valid, scene_, &ctx, &r);
+                for (int l = 0; l < count; ++l)
+                    if (r.tfar[l] != -inf) {
+                        set_bit(words.data(), s.order[lane_j[l]]);
+                        vis[lane_j[l]] = 1.0f;
+                    }
+            }
+            traced += m;
+            const Shading result = shading_from_arrays(xs.data(), ys.data(), zs.data(), cs.data(),
+                                                       s.sorted_weights.data(), vis.data(), padded, f.normal,
+                                                       s.normalize);
+            store_vertex(s, std::uint32_t(v), result, words.data(), out, clamped);
         }
         rays += traced;
         progress.advance(e - b);
