@@ -1,0 +1,74 @@
+// Slow tests of the neural sky: training at a useful scale on the `earth`
+// preset (200,000 samples): the seed's topology learns the sky to the accuracy
+// documented in docs/neural.md, a larger topology does better on the same
+// data, and the error report agrees with an independent recomputation.
+#include <cmath>
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+#include "skybake/neural.h"
+
+using namespace skybake;
+
+namespace {
+
+const SkyModel& earth() {
+    static const SkyModel m(atmosphere_preset("earth"));
+    return m;
+}
+
+NeuralSky train(const char* topology, int epochs, int lm) {
+    NeuralTrainOptions o;
+    o.topology = parse_topology(topology);
+    o.samples = 200000;
+    o.adam_epochs = epochs;
+    o.lm_iterations = lm;
+    o.progress = false;
+    return train_neural_sky(earth(), o);
+}
+
+} // namespace
+
+TEST(NeuralSlow, SeedTopologyLearnsAndLargerIsBetter) {
+    const NeuralSky paper = train("paper", 30, 15);
+    const NeuralSky wide = train("independent:16x16", 80, 5);
+    // docs/neural.md: the seed's topology reaches a held-out RMS of about
+    // 0.027 on 800,000 samples; a constant predictor has about 0.25.
+    EXPECT_LT(paper.training.heldout_rms, 0.045);
+    EXPECT_LT(wide.training.heldout_rms, 0.8 * paper.training.heldout_rms);
+
+    NeuralErrorOptions eo;
+    eo.samples = 20000;
+    eo.views = false;
+    const NeuralErrorReport a = measure_neural_sky_error(paper, eo);
+    const NeuralErrorReport b = measure_neural_sky_error(wide, eo);
+    EXPECT_LT(a.day.p50, 0.35);
+    EXPECT_LT(b.day.p50, a.day.p50);
+    EXPECT_EQ(a.all.count, a.day.count + a.twilight.count);
+    EXPECT_EQ(a.all.count + a.night.count, 20000u);
+
+    // Independent recomputation of the day median from the public API.
+    const std::vector<SkySample> s = draw_sky_samples(eo.samples, eo.seed);
+    std::vector<glm::vec3> ref(s.size()), got(s.size());
+    evaluate_sky(earth(), s, ref, SkyMethod::Tables);
+    evaluate_neural_sky(paper, s, got);
+    std::vector<double> day;
+    for (std::size_t i = 0; i < s.size(); ++i)
+        if (s[i].cos_sun_zenith > 0.0f && std::max({ref[i].x, ref[i].y, ref[i].z}) > 0.0f)
+            day.push_back(double(glm::length(got[i] - ref[i]) / glm::length(ref[i])));
+    std::nth_element(day.begin(), day.begin() + std::ptrdiff_t((day.size() - 1) / 2), day.end());
+    EXPECT_NEAR(day[(day.size() - 1) / 2], a.day.p50, 1e-3 * a.day.p50);
+}
+
+TEST(NeuralSlow, ViewsOfATrainedNetworkResembleTheReference) {
+    const NeuralSky net = train("independent:16x16", 30, 0);
+    NeuralErrorOptions eo;
+    eo.samples = 1000;
+    eo.view_width = 120;
+    eo.view_height = 80;
+    const NeuralErrorReport r = measure_neural_sky_error(net, eo);
+    ASSERT_EQ(r.views.size(), 6u);
+    // docs/neural.md: about 26 dB for this topology trained on 800,000 samples.
+    EXPECT_GT(r.mean_view_psnr_db, 18.0);
+}
