@@ -78,7 +78,7 @@ Scene& scene(int kind, std::uint64_t triangles, const std::string& rule, bool wi
         int lane = 0;
         for (std::uint32_t j = 0; j < setup.directions; ++j) {
             const glm::vec3 x = visibility::rule_direction(f.rotation, setup.rotate, setup.points[order[j]]);
-            if (!(glm::dot(f.normal, x) > 0.0f))
+            if (!visibility::needs_ray(glm::dot(f.normal, x)))
                 continue;
             RTCRay r{};
             r.org_x = f.origin.x, r.org_y = f.origin.y, r.org_z = f.origin.z, r.tnear = 0.0f;

@@ -47,7 +47,7 @@ struct AoBakeReport {
     std::size_t vertices = 0;
     std::size_t triangles = 0;
     std::size_t directions = 0;    // rule points
-    std::uint64_t rays = 0;        // rays traced (directions above each vertex's horizon)
+    std::uint64_t rays = 0;        // rays traced (directions on or above each vertex's horizon)
     double seconds = 0.0;          // whole bake: BVH build + rays + reduction
     double build_seconds = 0.0;    // BVH build
     double trace_seconds = 0.0;    // rays + reduction

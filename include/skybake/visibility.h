@@ -67,9 +67,15 @@ BackFaces parse_back_faces(const std::string& text);
 // For every vertex p with unit normal n, and every direction x_k of a sphere
 // rule {x_k, w_k} (turned by the vertex's random rotation when the rule asks
 // for it), the bake decides the seed's visibility
-//     V_p(x_k) = 1  if n·x_k > 0 and the ray from p along x_k leaves the mesh,
-//                0  otherwise (below the horizon, or blocked).
-// Directions below the horizon need no ray. A ray starts at
+//     V_p(x_k) = 1  if n·x_k ≥ 0 and the ray from p along x_k leaves the mesh,
+//                0  otherwise (below the horizon, or blocked),
+// and sums
+//     AO = Σ_k w_k 4 (n·x_k)+ V_k,     A = Σ_k w_k 2 H(n·x_k) V_k,
+//     bent normal = normalise(Σ_k w_k (n·x_k)+ V_k x_k),
+// with H = 1 above the horizon, ½ on it (n·x_k = 0 exactly: symmetric rules
+// put whole orbits there for axis-aligned normals; the midpoint value of the
+// step keeps A unbiased) and 0 below. Directions below the horizon need no ray.
+// A ray starts at
 //     origin = p + offset·n,   t in [0, max_distance],
 // so that it does not hit the triangles around p itself.
 
@@ -85,9 +91,9 @@ struct BakeOptions {
     // Negative (the default): kDefaultRayOffsetScale × bounding-box diagonal.
     float ray_offset = -1.0f;
     BackFaces back_faces = BackFaces::Occlude;
-    // false (the seed's definition): AO = Σ_k w_k 4(n·x_k)+ V_k and A = Σ_k w_k 2[n·x_k>0] V_k,
-    //   clamped to [0, 1] (rules with negative weights, and the rule's own error
-    //   for the clamped cosine, can push the sums slightly out).
+    // false (the seed's definition): the sums above, clamped to [0, 1] (rules
+    //   with negative weights, and the rule's own error for the clamped cosine,
+    //   can push them slightly out).
     // true: divide each sum by its value with V ≡ 1, so that an unoccluded
     //   vertex gets exactly 1 whatever the rule (a ratio estimator).
     bool normalize = false;
@@ -105,9 +111,10 @@ float resolve_ray_offset(const Mesh& mesh, const BakeOptions& options);
 // directions; skybake uses uint32 words of 32): vertex v owns words_per_vertex =
 // ceil(K / 32) consecutive words starting at v·words_per_vertex; the bit of rule
 // direction k is bit (k mod 32) (least significant first) of word k / 32. A set
-// bit means V = 1 (visible, above the horizon and unblocked). Unused high bits of
+// bit means V = 1 (visible: not below the horizon, and unblocked). Unused high bits of
 // a vertex's last word are 0. Direction k is the rule's k-th point, turned by the
-// vertex's rotation when the rule has "+rotate".
+// vertex's rotation when the rule has "+rotate". Bits below the horizon are 0;
+// bits exactly on it hold the grazing ray's answer.
 struct BakeOutputs {
     // One entry per vertex.
     std::vector<float> ao;              // cosine-weighted visibility V0 (seed 002, def. 1), in [0, 1]
@@ -118,7 +125,7 @@ struct BakeOutputs {
     std::uint32_t words_per_vertex = 0; // ceil(K / 32)
     std::vector<std::uint32_t> visibility_bits;
     // Statistics.
-    std::uint64_t rays = 0;             // rays traced (directions above the horizon)
+    std::uint64_t rays = 0;             // rays traced (directions on or above the horizon)
     std::uint64_t clamped_vertices = 0; // vertices whose AO or A sum left [0, 1] and was clamped
     float ray_offset = 0.0f;            // offset used, mesh units
     double build_seconds = 0.0;         // acceleration structure

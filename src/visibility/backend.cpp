@@ -82,7 +82,7 @@ void VisibilityBackend::bake(const Mesh& mesh, const SphereRule& rule, const Bak
                 glm::vec3 x;
                 float c;
                 visibility::vertex_direction(s.points[k], frame.rotation, s.rotate, frame.normal, x, c);
-                if (c > 0.0f) {
+                if (visibility::needs_ray(c)) {
                     batch.push_back({frame.origin, 0.0f, x, s.t_max});
                     index.push_back(k);
                 }

@@ -5,10 +5,11 @@
 // (seed 002; docs/SEEDS-DIGEST.md). With the normalised measure dμ = dω/4π and a
 // sphere rule {x_k, w_k}:
 //     V0 (ambient occlusion) = ∫ V 4(n·x)+ dμ ≈ Σ_k w_k 4 (n·x_k)+ V_k
-//     A  (shading coeff.)    = 2 ∫ V dμ        ≈ Σ_k w_k 2 [n·x_k > 0] V_k
+//     A  (shading coeff.)    = 2 ∫ V dμ        ≈ Σ_k w_k 2 H(n·x_k) V_k
 //     bent normal            = normalise(Σ_k w_k V_k (n·x_k)+ x_k)
-// where V_k = 1 when direction k is above the horizon and unblocked. The seed's
-// V is 0 below the horizon, so a visibility bit is never set there.
+// where V_k = 1 when direction k is not below the horizon and unblocked, and
+// H is the step 1 above, ½ on and 0 below the horizon (see add_direction). The
+// seed's V is 0 below the horizon, so a visibility bit is never set there.
 //
 // Bit layout (also in skybake/visibility.h): uint32 words, direction k is bit
 // k % 32 of word k / 32; the seed used uint16 words of 16 directions.
@@ -69,15 +70,24 @@ struct ShadingPartials {
 };
 
 // One direction (x, y, z) (unit, world space) with weight w, cos_n = n·x and
-// visible = 1 or 0, into partial `lane`. A direction with cos_n ≤ 0 (below the
-// horizon) adds nothing, an invisible one adds to the unoccluded sums only.
+// visible = 1 or 0, into partial `lane`. Below the horizon (cos_n < 0) adds
+// nothing; an invisible direction adds to the unoccluded sums only.
+//
+// Directions exactly on the horizon (cos_n = 0) are traced too and count half
+// in A: A's integrand steps there, and symmetric rules (Lebedev, designs) put
+// whole orbits on the great circle of an axis-aligned normal (about 3% of the
+// weight for lebedev:1202). Leaving them out, as the seed's V = 0 for n·x ≤ 0
+// would, biases A low by that much; the midpoint value removes the bias. AO's
+// weight (n·x)+ is 0 there anyway.
+//
 // Written without branches; adding the zero terms leaves the sums unchanged.
 SKYBAKE_HD_INLINE void add_direction(ShadingPartials& p, std::uint32_t lane, float w, float cos_n, float x, float y,
                                      float z, float visible) {
     const float up = float(cos_n > 0.0f);
-    const float seen = visible * up;
+    const float step = 0.5f * (up + float(cos_n >= 0.0f)); // 1 above, ½ on, 0 below the horizon
+    const float seen = visible * float(cos_n >= 0.0f);
     const float wc = w * cos_n * up;
-    const float ao = 4.0f * wc, a = 2.0f * w * up, b = wc * seen;
+    const float ao = 4.0f * wc, a = 2.0f * w * step, b = wc * seen;
     p.ao_open[lane] += ao;
     p.a_open[lane] += a;
     p.ao[lane] += ao * seen;
@@ -86,6 +96,9 @@ SKYBAKE_HD_INLINE void add_direction(ShadingPartials& p, std::uint32_t lane, flo
     p.by[lane] += b * y;
     p.bz[lane] += b * z;
 }
+
+// Whether direction k needs a ray: on or above the horizon.
+SKYBAKE_HD_INLINE bool needs_ray(float cos_n) { return cos_n >= 0.0f; }
 
 SKYBAKE_HD_INLINE ShadingSums combine_partials(const ShadingPartials& p) {
     ShadingSums s;

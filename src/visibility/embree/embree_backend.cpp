@@ -276,11 +276,11 @@ void EmbreeBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOpt
             // All rays of the vertex share origin and interval: set those lanes once.
             for (int l = 0; l < kPacket; ++l)
                 set_lane(r, l, f.origin, f.normal, 0.0f, s.t_max);
-            // Branch-free selection of the directions above the horizon ...
+            // Branch-free selection of the directions on or above the horizon ...
             std::uint32_t m = 0;
             for (std::uint32_t j = 0; j < s.directions; ++j) {
                 sel[m] = j;
-                m += std::uint32_t(cs[j] > 0.0f);
+                m += std::uint32_t(needs_ray(cs[j]));
             }
             // ... traced 16 at a time. Occluded lanes come back with tfar = -inf.
             for (std::uint32_t base = 0; base < m; base += kPacket) {
