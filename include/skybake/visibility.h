@@ -33,7 +33,7 @@ struct SphereRule;
 
 // [SECTION] Rays and hits ------------------------------------------------------------
 
-// A ray segment: the points origin + t·direction for t_min ≤ t ≤ t_max.
+// A ray segment: the points origin + t·direction for t_min < t ≤ t_max.
 struct Ray {
     glm::vec3 origin{0.0f};           // world space, mesh units
     float t_min = 0.0f;               // ≥ 0, in units of |direction|
@@ -76,8 +76,13 @@ BackFaces parse_back_faces(const std::string& text);
 // put whole orbits there for axis-aligned normals; the midpoint value of the
 // step keeps A unbiased) and 0 below. Directions below the horizon need no ray.
 // A ray starts at
-//     origin = p + offset·n,   t in [0, max_distance],
-// so that it does not hit the triangles around p itself.
+//     origin = p + offset·(n + u),   t in (0, max_distance],
+// so that it does not hit the triangles around p itself. u is zero for most
+// vertices; for a vertex on a mesh border or where two surfaces meet (its
+// triangles' area-weighted mean centroid is off the vertex) it is the unit
+// tangent towards that centroid: a floor vertex at the foot of a wall, or the
+// bottom edge of a box standing on the ground, then starts its rays just off
+// the other surface instead of on it.
 
 // The default offset is this fraction of the mesh's bounding-box diagonal:
 // scale-aware, so a bake does not change when the mesh is scaled or moved.
@@ -87,7 +92,8 @@ struct BakeOptions {
     // Occluders further than this from the ray origin are ignored, in mesh units.
     // Infinity (the default) means unlimited; must be > 0.
     float max_distance = std::numeric_limits<float>::infinity();
-    // Distance the ray origin is moved along the vertex normal, in mesh units.
+    // Distance the ray origin is moved along the vertex normal (and, on borders
+    // and creases, towards the vertex's triangles), in mesh units.
     // Negative (the default): kDefaultRayOffsetScale × bounding-box diagonal.
     float ray_offset = -1.0f;
     BackFaces back_faces = BackFaces::Occlude;
@@ -152,7 +158,7 @@ public:
     virtual void set_mesh(const Mesh& mesh, BackFaces back_faces = BackFaces::Occlude) = 0;
 
     // Occlusion queries against the current mesh: occluded[i] = 1 if some
-    // triangle meets rays[i] within [t_min, t_max], else 0. occluded.size() must
+    // triangle meets rays[i] within (t_min, t_max], else 0. occluded.size() must
     // equal rays.size(). Thread-safe; parallel inside for large batches.
     virtual void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const = 0;
 

@@ -180,6 +180,35 @@ TEST(AmbientOcclusion, FiniteWallMatchesPolygonFormFactor) {
     }
 }
 
+TEST(AmbientOcclusion, VerticesWhereTwoSurfacesMeet) {
+    // The wall scene's floor and wall meet along z = -1, y = 0 with separate
+    // vertices. A floor vertex there sees the wall fill the back half of its
+    // sky; a wall vertex there sees the floor. Closed forms: the limits of
+    // Lambert's formula as the point approaches the edge. Both backends must
+    // agree: the ray origins start off the other surface (skybake/visibility.h).
+    Mesh m = generated(ProceduralKind::Wall, 600);
+    const std::vector<glm::dvec3> wall = {{-1, 0, -1}, {1, 0, -1}, {1, 1, -1}, {-1, 1, -1}};
+    const std::vector<glm::dvec3> floor = {{-1, 0, -1}, {-1, 0, 1}, {1, 0, 1}, {1, 0, -1}};
+    const SphereRule rule = parse_rule("lebedev:590+rotate");
+    Mesh mb = m;
+    bake_ambient_occlusion(m, rule, "embree");
+    bake_ambient_occlusion(mb, rule, "brute");
+    std::size_t tested = 0;
+    for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+        const glm::dvec3 p = m.positions[v];
+        if (p.y != 0.0 || p.z != -1.0 || std::abs(p.x) > 0.8)
+            continue;
+        const bool on_floor = m.normals[v].y > 0.5f;
+        const double f = on_floor ? polygon_form_factor(p + glm::dvec3(0, 0, 1e-9), {0, 1, 0}, wall)
+                                  : polygon_form_factor(p + glm::dvec3(0, 1e-9, 0), {0, 0, 1}, floor);
+        const float ao = m.find_attribute("ao")->values[v], ao_brute = mb.find_attribute("ao")->values[v];
+        EXPECT_NEAR(ao, 1.0 - f, 0.03) << (on_floor ? "floor" : "wall") << " vertex at x = " << p.x;
+        EXPECT_NEAR(ao, ao_brute, 0.01) << "x = " << p.x;
+        ++tested;
+    }
+    EXPECT_GE(tested, 10u);
+}
+
 TEST(AmbientOcclusion, InfiniteWallLimit) {
     // A wall 2W wide and H tall at distance d = 1 from a small floor patch at the
     // origin. Its floor is left out: a floor does not occlude its own points.

@@ -169,6 +169,8 @@ BakeSetup prepare_bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
         s.normals[v] = fallback[v];
     }
 
+    s.inward = vertex_inward_directions(mesh, s.normals);
+
     out = BakeOutputs{};
     out.ao.assign(n, 0.0f);
     out.shading.assign(n, 0.0f);
@@ -184,7 +186,7 @@ BakeSetup prepare_bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
 VertexFrame vertex_frame(const BakeSetup& s, const Mesh& mesh, std::uint32_t vertex) {
     VertexFrame f;
     f.normal = s.normals[vertex];
-    f.origin = ray_origin(mesh.positions[vertex], f.normal, s.offset);
+    f.origin = ray_origin(mesh.positions[vertex], f.normal, s.inward[vertex], s.offset);
     if (s.rotate)
         f.rotation = sphere::vertex_rotation_hd<float>(vertex, s.rotation_seed);
     return f;
@@ -206,6 +208,38 @@ void store_vertex(const BakeSetup& s, std::uint32_t vertex, const Shading& r, co
         clamped.fetch_add(1, std::memory_order_relaxed);
     if (s.store_bits)
         std::copy(words, words + s.words, out.visibility_bits.begin() + std::ptrdiff_t(std::size_t(vertex) * s.words));
+}
+
+std::vector<glm::vec3> vertex_inward_directions(const Mesh& mesh, const std::vector<glm::vec3>& normals) {
+    const std::size_t n = mesh.vertex_count();
+    std::vector<glm::dvec3> sum(n, glm::dvec3(0.0));
+    std::vector<double> area(n, 0.0), dist(n, 0.0);
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+        const std::uint32_t* i = &mesh.indices[3 * t];
+        const glm::dvec3 p0 = mesh.positions[i[0]], p1 = mesh.positions[i[1]], p2 = mesh.positions[i[2]];
+        const double a = 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0));
+        if (!(a > 0.0))
+            continue;
+        const glm::dvec3 c = (p0 + p1 + p2) / 3.0;
+        for (int k = 0; k < 3; ++k) {
+            const glm::dvec3 d = c - glm::dvec3(mesh.positions[i[k]]);
+            sum[i[k]] += a * d;
+            area[i[k]] += a;
+            dist[i[k]] += a * glm::length(d);
+        }
+    }
+    std::vector<glm::vec3> inward(n, glm::vec3(0.0f));
+    for (std::size_t v = 0; v < n; ++v) {
+        if (!(area[v] > 0.0))
+            continue;
+        const glm::dvec3 nv = normals[v];
+        glm::dvec3 m = sum[v] / area[v];
+        m -= glm::dot(m, nv) * nv; // tangential part
+        const double len = glm::length(m);
+        if (len > 0.05 * dist[v] / area[v])
+            inward[v] = glm::vec3(m / len);
+    }
+    return inward;
 }
 
 namespace {

@@ -33,6 +33,7 @@ struct BakeSetup {
     float offset = 0.0f;   // mesh units
     float t_max = 0.0f;    // mesh units (may be infinite)
     std::vector<glm::vec3> normals; // unit
+    std::vector<glm::vec3> inward;  // unit or zero, see vertex_inward_directions()
 };
 
 // Per-vertex ray frame.
@@ -55,6 +56,14 @@ void finish_vertex(const BakeSetup& setup, const VertexFrame& frame, std::uint32
 // Stores one vertex's reduced result (and its words when store_bits).
 void store_vertex(const BakeSetup& setup, std::uint32_t vertex, const Shading& result, const std::uint32_t* words,
                   BakeOutputs& out, std::atomic<std::uint64_t>& clamped);
+
+// Per vertex: the unit tangent from the vertex towards the area-weighted mean
+// centroid of its triangles, when that mean is off the vertex by more than 5%
+// of their mean distance (border vertices, and vertices where one surface
+// meets another); zero otherwise. Moving a ray origin a little along it keeps
+// the origin off a surface that merely touches the vertex: a floor vertex at
+// the foot of a wall, the bottom edge of a box standing on the ground.
+std::vector<glm::vec3> vertex_inward_directions(const Mesh& mesh, const std::vector<glm::vec3>& normals);
 
 // Orders rule directions so that consecutive ones are close on the sphere
 // (Morton order of the octahedral map): packets of consecutive rays from one

@@ -41,9 +41,12 @@ SKYBAKE_HD_INLINE glm::vec3 rule_direction(const glm::mat3& rotation, bool rotat
     return rotate ? rotation * x : x;
 }
 
-// Ray origin: the vertex moved by `offset` (mesh units) along its unit normal.
-SKYBAKE_HD_INLINE glm::vec3 ray_origin(const glm::vec3& position, const glm::vec3& normal, float offset) {
-    return position + offset * normal;
+// Ray origin: the vertex moved by `offset` (mesh units) along its unit normal
+// and along `inward`, a unit tangent towards its own triangles for vertices on
+// a border or a crease (zero elsewhere; see vertex_inward_directions()).
+SKYBAKE_HD_INLINE glm::vec3 ray_origin(const glm::vec3& position, const glm::vec3& normal, const glm::vec3& inward,
+                                       float offset) {
+    return position + offset * (normal + inward);
 }
 
 // [SECTION] Reduction -------------------------------------------------------------------

@@ -14,7 +14,7 @@ namespace skybake::visibility {
 
 // Triangle p0, p1 = p0 + e1, p2 = p0 + e2. Returns true and the distance t and
 // barycentrics (u, v) of p1 and p2 when the ray o + t·d meets it with
-// t_min ≤ t ≤ t_max. Edges and vertices count as inside (u, v ≥ 0, u + v ≤ 1),
+// t_min < t ≤ t_max (a hit exactly at t_min, e.g. at the origin, does not count). Edges and vertices count as inside (u, v ≥ 0, u + v ≤ 1),
 // so a ray through a shared edge hits one of its triangles. Rays parallel to
 // the plane (det = 0) miss, and so do degenerate triangles.
 template <class T>
@@ -35,7 +35,7 @@ SKYBAKE_HD_INLINE bool ray_triangle(const glm::vec<3, T>& o, const glm::vec<3, T
     if (!(v >= T(0) && u + v <= T(1)))
         return false;
     t = glm::dot(e2, qvec) * inv;
-    return t >= t_min && t <= t_max;
+    return t > t_min && t <= t_max;
 }
 
 } // namespace skybake::visibility
