@@ -141,7 +141,8 @@ SkyModel neural_reference_model(const NeuralSky& net);
 // be valid (is_valid_sky_sample; asserted). out.size() must equal samples.size().
 // Batch inference is vectorised (Eigen) and uses all cores; deterministic.
 void evaluate_neural_sky(const NeuralSky& net, std::span<const SkySample> samples, std::span<glm::vec3> out);
-// One sample through the scalar forward pass that shaders and CUDA share.
+// One sample through the scalar forward pass that shaders and CUDA share
+// (sets up the layout on every call: use evaluate_neural_sky for many samples).
 glm::vec3 neural_sky_radiance(const NeuralSky& net, const SkySample& sample);
 // The 4 encoded outputs (R, G, B, M) of the scalar forward pass.
 void neural_sky_encoded(const NeuralSky& net, const SkySample& sample, float encoded[4]);
@@ -176,7 +177,8 @@ struct NeuralTrainOptions {
 struct LearningCurvePoint {
     int epoch = 0;
     std::string phase;
-    double train_rms = 0.0;        // RMS error of the encoded outputs on the training set
+    double train_rms = 0.0;        // RMS error of the encoded outputs on the training set (Adam: mean over the
+                                   // epoch's mini-batches as they were trained; LM: after the iteration)
     double heldout_rms = 0.0;      // same on the held-out set
     double heldout_mean_relative = 0.0; // mean |ΔI|/|I| on held-out samples with N > 0
     double seconds = 0.0;          // since training started
