@@ -42,7 +42,9 @@ struct MlpHD {
     float log_range = 13.8155106f;  // nats
 };
 
-// The seed's activation.
+// The seed's activation, as printed. Its vertex program computes
+// 1/(1 + 2^(−2x)) = 1 − f(x) (MUL by −2.0, EX2, ADD 1, RCP): the same networks
+// with the signs of every neuron's incoming weights and bias flipped.
 SKYBAKE_HD_INLINE float seed_activation(float x) { return 1.0f / (1.0f + exp2f(2.0f * x)); }
 
 // One sub-network: in[width[0]] -> out[width[layers]].
