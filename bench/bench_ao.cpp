@@ -7,8 +7,8 @@
 //     bare16: rtcOccluded16 over the stored packets,
 //     bare1:  rtcOccluded1 over the stored rays one by one,
 //   both spread over the same TBB threads. Counters: Mrays/s of each and the
-//   ratios bake/bare (target ≥ 0.9). The three are interleaved in every
-//   iteration, so a busy machine slows all of them alike.
+//   ratios bake/bare (target ≥ 0.9). The three run in every iteration (the
+//   bake first, then last, alternately), so a busy machine slows all alike.
 // BM_AoTableCase: seed 002's table case, about 5k vertices with lebedev:5810,
 //   whole bake (BVH build included). The seed: > 1 h on its CPU, 0.8 s CUDA.
 // BM_AoLargeMesh: throughput on a generated mesh of ≥ 1M triangles.
@@ -161,12 +161,29 @@ void BM_AoVsBareEmbree(benchmark::State& state) {
     o.store_bits = true;
     double t_bake = 0, t16 = 0, t1 = 0;
     std::uint64_t rays = 0;
+    bool bake_first = true;
     for (auto _ : state) {
+        // Alternate the order, so that neither side always runs on a warmer cache.
+        std::uint64_t occ16 = 0, occ1 = 0;
+        double a = 0, c = 0;
+        if (!bake_first) {
+            a = bare16(s, occ16);
+            c = bare1(s, occ1);
+        }
         BakeOutputs out;
         s.backend.bake(s.mesh, s.rule, o, out);
-        std::uint64_t occ16 = 0, occ1 = 0;
-        const double a = bare16(s, occ16), c = bare1(s, occ1);
-        if (out.rays != s.rays.size() || occ16 != occluded_in_bake(s, out) || occ1 != occ16) {
+        if (bake_first) {
+            a = bare16(s, occ16);
+            c = bare1(s, occ1);
+        }
+        bake_first = !bake_first;
+        // The bake traces the same rays as the bare loops. Single rays and
+        // packets may disagree on a ray that grazes an edge: a few in 10^4.
+        const std::uint64_t occ = occluded_in_bake(s, out);
+        const auto close = [&](std::uint64_t x) {
+            return double(x > occ ? x - occ : occ - x) <= 1e-4 * double(out.rays);
+        };
+        if (out.rays != s.rays.size() || !close(occ16) || !close(occ1)) {
             state.SkipWithError("the bare loops and the bake disagree");
             return;
         }
@@ -184,6 +201,7 @@ void BM_AoVsBareEmbree(benchmark::State& state) {
     state.counters["bare1_Mrays"] = double(rays) * it / t1 * 1e-6;
     state.counters["ratio_bare16"] = t16 / t_bake;
     state.counters["ratio_bare1"] = t1 / t_bake;
+    state.counters["ratio_best"] = std::min(t16, t1) / t_bake; // against the faster bare loop
 }
 
 // Args: kind, triangles. lebedev:5810.
@@ -237,12 +255,15 @@ void BM_AoLargeMesh(benchmark::State& state) {
 
 BENCHMARK(BM_AoVsBareEmbree)
     ->ArgNames({"kind", "tris", "rule"})
-    ->Args({0, 3000, 1202})  // city, ~5k vertices
-    ->Args({1, 10000, 1202}) // torus, ~5k vertices
-    ->Args({0, 200000, 110}) // city, 200k triangles
+    ->Args({0, 3000, 1202})    // city, ~5k vertices: packets
+    ->Args({1, 10000, 1202})   // torus, ~5k vertices: packets
+    ->Args({0, 3000, 302})     // city, ~5k vertices: single rays
+    ->Args({0, 50000, 590})    // city, 85k vertices: single rays
+    ->Args({0, 200000, 110})   // city, 340k vertices: single rays
+    ->Args({2, 1000000, 50})   // terrain, 1M triangles: single rays
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
-    ->Iterations(3);
+    ->Iterations(6);
 BENCHMARK(BM_AoTableCase)
     ->ArgNames({"kind", "tris"})
     ->Args({0, 3000})  // city, ~5k vertices

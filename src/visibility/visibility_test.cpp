@@ -121,10 +121,12 @@ TEST(Visibility, EmbreeAgreesWithBruteForceOnRandomRays) {
 }
 
 TEST(Visibility, BakeAgreesWithBruteForceOnRandomMeshes) {
-    for (const char* spec : {"lebedev:110", "fibonacci:200+rotate=5", "mc:300,seed=3+rotate"}) {
-        for (std::uint32_t seed = 11; seed <= 12; ++seed) {
-            const Mesh m = random_mesh(seed, 120);
-            const SphereRule rule = parse_rule(spec);
+    // Small rules go ray by ray, large ones (≥ 1000 directions) in packets.
+    for (const char* spec : {"lebedev:110", "fibonacci:200+rotate=5", "mc:300,seed=3+rotate", "lebedev:1202",
+                             "fibonacci:1500+rotate"}) {
+        const SphereRule rule = parse_rule(spec);
+        for (std::uint32_t seed = 11; seed <= (rule.size() < 1000 ? 12u : 11u); ++seed) {
+            const Mesh m = random_mesh(seed, rule.size() < 1000 ? 120 : 60);
             BakeOptions o;
             o.store_bits = true;
             BakeOutputs a, b;
@@ -284,26 +286,28 @@ TEST(Visibility, MaxDistanceIgnoresFarOccluders) {
 
 TEST(Visibility, ResultsDoNotDependOnThreadCount) {
     const Mesh m = random_mesh(21, 300);
-    const SphereRule rule = parse_rule("lebedev:230+rotate=9");
-    BakeOptions o;
-    o.store_bits = true;
-    BakeOutputs one, all;
-    set_thread_count(1);
-    make_visibility_backend("embree")->bake(m, rule, o, one);
-    set_thread_count(0);
-    make_visibility_backend("embree")->bake(m, rule, o, all);
-    EXPECT_EQ(one.ao, all.ao);
-    EXPECT_EQ(one.shading, all.shading);
-    EXPECT_EQ(one.bent_normal, all.bent_normal);
-    EXPECT_EQ(one.visibility_bits, all.visibility_bits);
-    EXPECT_EQ(one.rays, all.rays);
+    for (const char* spec : {"lebedev:230+rotate=9", "lebedev:1202"}) {
+        const SphereRule rule = parse_rule(spec);
+        BakeOptions o;
+        o.store_bits = true;
+        BakeOutputs one, all;
+        set_thread_count(1);
+        make_visibility_backend("embree")->bake(m, rule, o, one);
+        set_thread_count(0);
+        make_visibility_backend("embree")->bake(m, rule, o, all);
+        EXPECT_EQ(one.ao, all.ao) << spec;
+        EXPECT_EQ(one.shading, all.shading);
+        EXPECT_EQ(one.bent_normal, all.bent_normal);
+        EXPECT_EQ(one.visibility_bits, all.visibility_bits);
+        EXPECT_EQ(one.rays, all.rays);
+    }
 }
 
 TEST(Visibility, ReductionFromBitsEqualsTheBake) {
     // The HD reduction from stored bits (what a CUDA kernel would run) gives the
     // bake's results bit for bit: same arithmetic, same order.
     const Mesh m = random_mesh(31, 150);
-    for (const char* spec : {"lebedev:266", "design:t9+rotate=4"}) {
+    for (const char* spec : {"lebedev:266", "design:t9+rotate=4", "lebedev:1202+rotate"}) {
         const SphereRule rule = parse_rule(spec);
         for (bool normalize : {false, true}) {
             BakeOptions o;

@@ -3,11 +3,13 @@
 // Wald I., Woop S., Benthin C., Johnson G. S., Ernst M. Embree: a kernel
 // framework for efficient CPU ray tracing. ACM TOG 33(4), SIGGRAPH 2014.
 //
-// The bake casts, for each vertex, the rule directions above its horizon from
-// one origin. Directions are visited in a fixed coherent order (Morton order of
-// the octahedral map, bake_common.h) and issued as 16-ray packets
-// (rtcOccluded16, coherent context flag): rays of one packet share the origin and
-// point into a small patch of the sphere, so they traverse the BVH together.
+// The bake casts, for each vertex, the rule directions on or above its horizon
+// from one origin. Directions are visited in a fixed coherent order (Morton
+// order of the octahedral map, bake_common.h). With a large rule they are issued
+// as 16-ray packets (rtcOccluded16, coherent context flag): rays of one packet
+// share the origin and point into a small patch of the sphere, so they traverse
+// the BVH together. With a small rule a packet would spread over the whole sky
+// and single rays (rtcOccluded1) are faster.
 // Vertices are spread over TBB tasks; each vertex's result depends on that vertex
 // alone, so the output does not depend on the thread count.
 #include "visibility/embree/embree_backend.h"
@@ -35,6 +37,9 @@ namespace skybake::visibility {
 namespace {
 
 constexpr int kPacket = 16;
+// Rules with at least this many directions are traced in 16-ray packets, others
+// ray by ray (measured crossover: between 590 and 1202 on the city scenes).
+constexpr std::uint32_t kPacketMinDirections = 1000;
 
 const char* error_name(RTCError code) {
     switch (code) {
@@ -251,25 +256,54 @@ void EmbreeBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOpt
     const float inf = std::numeric_limits<float>::infinity();
     Progress progress("ao", n);
     std::atomic<std::uint64_t> rays{0}, clamped{0};
-    parallel_for(n, 4, [&](std::size_t b, std::size_t e) {
-        RTCIntersectContext ctx = coherent_context();
+    // Packets pay when a vertex's rays are many, so that 16 consecutive ones in
+    // the coherent order point into a small patch of sky; with few directions
+    // single rays are faster (docs/PERFORMANCE.md).
+    const bool packets = s.directions >= kPacketMinDirections;
+    // Without rotation every vertex has the same directions: keep one copy.
+    std::vector<float> fixed_x(padded, 0.0f), fixed_y(padded, 0.0f), fixed_z(padded, 0.0f);
+    for (std::uint32_t j = 0; j < s.directions; ++j) {
+        fixed_x[j] = s.sorted_points[j].x;
+        fixed_y[j] = s.sorted_points[j].y;
+        fixed_z[j] = s.sorted_points[j].z;
+    }
+    // Tasks of about 8k directions: enough to hide the scratch set-up.
+    const std::size_t grain = std::clamp<std::size_t>(8192 / s.directions, 4, 256);
+    parallel_for(n, grain, [&](std::size_t b, std::size_t e) {
+        RTCIntersectContext ctx = coherent_context(), ctx1 = incoherent_context();
         alignas(64) RTCRay16 r;
         alignas(64) int valid[kPacket];
         std::vector<std::uint32_t> words(s.words);
         // Per-direction scratch in visiting order, structure of arrays,
         // zero-padded to `padded`.
-        std::vector<float> xs(padded, 0.0f), ys(padded, 0.0f), zs(padded, 0.0f), cs(padded, 0.0f), vis(padded);
+        std::vector<float> cs(padded, 0.0f), vis(padded), rx, ry, rz;
+        if (s.rotate) {
+            rx.assign(padded, 0.0f);
+            ry.assign(padded, 0.0f);
+            rz.assign(padded, 0.0f);
+        }
+        float* xs = s.rotate ? rx.data() : fixed_x.data();
+        float* ys = s.rotate ? ry.data() : fixed_y.data();
+        float* zs = s.rotate ? rz.data() : fixed_z.data();
         std::vector<std::uint32_t> sel(s.directions);
+        std::vector<RTCRay> ray1;
         std::uint64_t traced = 0;
         for (std::size_t v = b; v < e; ++v) {
             const VertexFrame f = vertex_frame(s, mesh, std::uint32_t(v));
             // Directions and cosines once per vertex; the reduction reuses them.
-            for (std::uint32_t j = 0; j < s.directions; ++j) {
-                glm::vec3 x;
-                vertex_direction(s.sorted_points[j], f.rotation, s.rotate, f.normal, x, cs[j]);
-                xs[j] = x.x;
-                ys[j] = x.y;
-                zs[j] = x.z;
+            if (s.rotate) {
+                for (std::uint32_t j = 0; j < s.directions; ++j) {
+                    glm::vec3 x;
+                    vertex_direction(s.sorted_points[j], f.rotation, true, f.normal, x, cs[j]);
+                    xs[j] = x.x;
+                    ys[j] = x.y;
+                    zs[j] = x.z;
+                }
+            } else {
+                for (std::uint32_t j = 0; j < s.directions; ++j) {
+                    glm::vec3 x;
+                    vertex_direction(s.sorted_points[j], f.rotation, false, f.normal, x, cs[j]);
+                }
             }
             std::fill(words.begin(), words.end(), 0u);
             std::fill(vis.begin(), vis.end(), 0.0f);
@@ -282,8 +316,37 @@ void EmbreeBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOpt
                 sel[m] = j;
                 m += std::uint32_t(needs_ray(cs[j]));
             }
-            // ... traced 16 at a time. Occluded lanes come back with tfar = -inf.
-            for (std::uint32_t base = 0; base < m; base += kPacket) {
+            if (!packets) {
+                // ... one by one (few directions: a packet would spread over the
+                // sky), set up first and traced in one tight loop, which measured
+                // 15% faster than interleaving set-up and calls.
+                ray1.resize(m);
+                for (std::uint32_t i = 0; i < m; ++i) {
+                    const std::uint32_t j = sel[i];
+                    RTCRay& one = ray1[i];
+                    one.org_x = f.origin.x;
+                    one.org_y = f.origin.y;
+                    one.org_z = f.origin.z;
+                    one.tnear = 0.0f;
+                    one.dir_x = xs[j];
+                    one.dir_y = ys[j];
+                    one.dir_z = zs[j];
+                    one.time = 0.0f;
+                    one.tfar = s.t_max;
+                    one.mask = 0xffffffffu;
+                    one.id = 0;
+                    one.flags = 0;
+                }
+                for (std::uint32_t i = 0; i < m; ++i)
+                    rtcOccluded1(scene_, &ctx1, &ray1[i]);
+                for (std::uint32_t i = 0; i < m; ++i)
+                    if (ray1[i].tfar != -inf) {
+                        set_bit(words.data(), s.order[sel[i]]);
+                        vis[sel[i]] = 1.0f;
+                    }
+            }
+            // ... or 16 at a time. Occluded lanes come back with tfar = -inf.
+            for (std::uint32_t base = 0; packets && base < m; base += kPacket) {
                 const int count = int(std::min<std::uint32_t>(kPacket, m - base));
                 const std::uint32_t* lane_j = sel.data() + base;
                 for (int l = 0; l < kPacket; ++l) {
@@ -303,7 +366,7 @@ void EmbreeBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOpt
                     }
             }
             traced += m;
-            const Shading result = shading_from_arrays(xs.data(), ys.data(), zs.data(), cs.data(),
+            const Shading result = shading_from_arrays(xs, ys, zs, cs.data(),
                                                        s.sorted_weights.data(), vis.data(), padded, f.normal,
                                                        s.normalize);
             store_vertex(s, std::uint32_t(v), result, words.data(), out, clamped);
