@@ -123,9 +123,11 @@ struct AoPreviewOptions {
 };
 
 // Ray-casts the mesh (Embree) from a camera that frames its bounding sphere and
-// shades each visible point by the baked AO, interpolated across the triangle:
-// linear grey = AO (background: a dark blue-grey). The mesh must carry the "ao"
-// attribute. Returns a linear image; save with save_image(..., ToneMap{0, Clamp}).
+// shades each visible point by the baked AO, interpolated across the triangle,
+// as a display value: the linear pixel is srgb_to_linear(AO), so that a PNG
+// written with save_image(..., ToneMap{0, ToneCurve::Clamp}) has grey level
+// 255·AO. Background: a dark blue-grey. 2×2 samples per pixel by default. The
+// mesh must carry the "ao" attribute.
 Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& options = {});
 
 } // namespace skybake

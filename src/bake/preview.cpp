@@ -1,6 +1,8 @@
 // Preview of a baked mesh: primary rays from a pinhole camera (Embree), each
 // hit shaded by the baked per-vertex AO interpolated with the hit's
-// barycentrics, as a vertex-colour viewer would show it.
+// barycentrics. The AO is shown as a display value (PNG grey level 255·AO),
+// which reads better than AO as linear light.
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -81,7 +83,7 @@ Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
                     const std::uint32_t* tri = &mesh.indices[3 * std::size_t(h.triangle)];
                     const float a = (1.0f - h.u - h.v) * ao->values[tri[0]] + h.u * ao->values[tri[1]] +
                                     h.v * ao->values[tri[2]];
-                    sum += glm::vec3(a);
+                    sum += glm::vec3(srgb_to_linear(std::clamp(a, 0.0f, 1.0f)));
                 }
                 sum /= float(s * s);
                 float* p = img.pixel(x, y);

@@ -1,0 +1,28 @@
+# Ambient occlusion: per-vertex AO, shading coefficient A and bent normals
+# (seed 002), baked with Embree, written as glTF (any viewer shows COLOR_0 = AO)
+# with PNG previews.
+set -euo pipefail
+models=/usr/share/assimp/models
+
+# The seed's table case: about 5k vertices with the 5810-point Lebedev rule.
+"$SKYBAKE" mesh generate --kind city --triangles 3000 --seed 1 -o "$OUT/ao_city_5k.glb"
+"$SKYBAKE" ao "$OUT/ao_city_5k.glb" -o "$OUT/ao_city_5k_baked.glb" --rule lebedev:5810 --json
+
+# A larger city and a terrain, with previews.
+"$SKYBAKE" mesh generate --kind city --triangles 60000 --seed 1 -o "$OUT/ao_city.glb"
+"$SKYBAKE" ao "$OUT/ao_city.glb" -o "$OUT/ao_city_baked.glb" --rule lebedev:590 \
+  --preview "$OUT/ao_city.png" --preview-size 640x480 --preview-elevation 35
+"$SKYBAKE" ao "$OUT/terrain.ply" -o "$OUT/ao_terrain_baked.ply" --rule lebedev:302 \
+  --preview "$OUT/ao_terrain.png" --preview-size 640x480 --preview-elevation 40
+
+# A real model, and its visibility bits in the seed's bit-packed form.
+"$SKYBAKE" ao "$models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb" -o "$OUT/ao_engine_baked.glb" \
+  --rule lebedev:590+rotate --preview "$OUT/ao_engine.png" --preview-size 640x480 --bits "$OUT/ao_engine_bits.bin"
+
+# Closed form: inside the hemispherical bowl AO is exactly 1/2.
+"$SKYBAKE" ao "$OUT/bowl.glb" -o "$OUT/ao_bowl_baked.glb" --rule lebedev:1202 --json | grep -A4 '"ao"'
+
+# Bad input is one line, exit code 1.
+if "$SKYBAKE" ao "$OUT/bowl.glb" -o "$OUT/nothing.glb" --backend cuda; then
+  echo "expected an error" >&2; exit 1
+fi
