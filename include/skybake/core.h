@@ -15,6 +15,14 @@ bool build_has_cuda();
 int cuda_device_count();
 // Name of CUDA device 0, or an empty string.
 std::string cuda_device_name();
+// Throws skybake::Error, naming `where` (e.g. "--device cuda"), when this
+// build has no CUDA support or no CUDA device is present.
+void require_cuda_device(const std::string& where);
+
+// Where batch work runs.
+enum class Device : int { Cpu = 0, Cuda = 1 };
+// "cpu" or "cuda"; throws skybake::Error naming `where` otherwise.
+Device parse_device(const std::string& name, const std::string& where = "--device");
 
 // Limits the worker threads used by parallel loops; 0 restores the default
 // (all hardware threads). Results do not depend on the thread count.

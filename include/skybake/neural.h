@@ -141,6 +141,11 @@ SkyModel neural_reference_model(const NeuralSky& net);
 // be valid (is_valid_sky_sample; asserted). out.size() must equal samples.size().
 // Batch inference is vectorised (Eigen) and uses all cores; deterministic.
 void evaluate_neural_sky(const NeuralSky& net, std::span<const SkySample> samples, std::span<glm::vec3> out);
+// The same on CUDA device 0: weights in constant memory, the seed's topology
+// fully unrolled with the activation on the special-function unit (agrees
+// with evaluate_neural_sky to 1e-5 relative), other topologies through the
+// shared forward pass. Throws skybake::Error without CUDA or a device.
+void evaluate_neural_sky_cuda(const NeuralSky& net, std::span<const SkySample> samples, std::span<glm::vec3> out);
 // One sample through the scalar forward pass that shaders and CUDA share
 // (sets up the layout on every call: use evaluate_neural_sky for many samples).
 glm::vec3 neural_sky_radiance(const NeuralSky& net, const SkySample& sample);

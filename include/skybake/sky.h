@@ -310,4 +310,12 @@ struct SkyRenderSettings {
 // planet seen from space. Uses all cores.
 Image render_sky(const SkyModel& model, const SkyRenderSettings& settings);
 
+// [SECTION] GPU ------------------------------------------------------------------------------
+// The tables method on CUDA device 0, with the same SKYBAKE_HD code as the CPU
+// path (results agree to float rounding). Both throw skybake::Error when the
+// build has no CUDA or no device is present; render_sky_cuda also for
+// SkyMethod::Exact, which runs on the CPU only.
+void evaluate_sky_cuda(const SkyModel& model, std::span<const SkySample> samples, std::span<glm::vec3> out);
+Image render_sky_cuda(const SkyModel& model, const SkyRenderSettings& settings);
+
 } // namespace skybake

@@ -5,6 +5,7 @@
 #include <glm/geometric.hpp>
 
 #include "skybake/sky.h"
+#include "sky/render_hd.h"
 #include "sky/sky_hd.h"
 
 namespace skybake::sky {
@@ -35,5 +36,9 @@ glm::dvec3 sun_transmittance_exact(const Atmosphere& atmosphere, const glm::dvec
 // entry distance (0 inside) and the exit or ground distance. False if it misses.
 bool atmosphere_segment(const Atmosphere& atmosphere, const glm::dvec3& origin_km, const glm::dvec3& dir,
                         double& enter_km, double& exit_km, bool& hits_ground);
+
+// Validates the settings (throws skybake::Error naming the flag) and sets up
+// the per-pixel parameters shared by the CPU and CUDA renderers.
+RenderHD make_render_hd(const SkyModel& model, const SkyRenderSettings& settings);
 
 } // namespace skybake::sky

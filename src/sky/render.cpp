@@ -51,7 +51,9 @@ glm::dvec3 shade_ray_exact(const Atmosphere& atm, const sky::RenderHD& p, const 
 
 } // namespace
 
-Image render_sky(const SkyModel& model, const SkyRenderSettings& s) {
+namespace sky {
+
+RenderHD make_render_hd(const SkyModel& model, const SkyRenderSettings& s) {
     const Atmosphere& atm = model.atmosphere();
     if (!(std::isfinite(s.altitude_km) && s.altitude_km >= 0.0 && s.altitude_km < 1e7))
         throw Error("the observer altitude must be 0 to 1e7 km", "--altitude-km");
@@ -90,6 +92,14 @@ Image render_sky(const SkyModel& model, const SkyRenderSettings& s) {
     p.sun_disc_radiance =
         s.sun_disc ? float(1.0 / (3.14159265358979323846 * atm.sun_angular_radius_rad * atm.sun_angular_radius_rad))
                    : 0.0f;
+    return p;
+}
+
+} // namespace sky
+
+Image render_sky(const SkyModel& model, const SkyRenderSettings& s) {
+    const Atmosphere& atm = model.atmosphere();
+    const sky::RenderHD p = sky::make_render_hd(model, s);
 
     Image image(s.width, s.height);
     Progress progress("render", std::uint64_t(s.height));

@@ -1,0 +1,223 @@
+// The neural sky on the GPU (seed 000, section VI: the network in a vertex
+// program; here a CUDA kernel).
+//
+// The weights live in constant memory: every thread of a warp reads the same
+// weight at the same time, which constant memory broadcasts. The seed's
+// topology (four 4-8-4-1 sub-networks) has a fully unrolled kernel with the
+// activation f(x) = 1/(1 + 2^(2x)) on the special-function unit
+// (ex2.approx, rcp.approx); other topologies run the shared generic forward
+// pass of mlp_hd.h, reading the weights from constant memory when they fit.
+#include <algorithm>
+
+#include "core/cuda_util.h"
+#include "neural/internal.h"
+#include "neural/mlp_hd.h"
+#include "neural/neural_cuda.h"
+#include "sky/internal.h"
+#include "skybake/core.h"
+
+namespace skybake::neural {
+
+namespace {
+
+constexpr int kConstantFloats = 16384; // 64 KiB
+__constant__ float c_weights[kConstantFloats];
+
+constexpr unsigned kBlock = 256;
+
+__device__ __forceinline__ float fast_exp2(float x) {
+    float y;
+    asm("ex2.approx.ftz.f32 %0, %1;" : "=f"(y) : "f"(x));
+    return y;
+}
+
+__device__ __forceinline__ float fast_rcp(float x) {
+    float y;
+    asm("rcp.approx.ftz.f32 %0, %1;" : "=f"(y) : "f"(x));
+    return y;
+}
+
+__device__ __forceinline__ float fast_activation(float x) { return fast_rcp(1.0f + fast_exp2(2.0f * x)); }
+
+// One 4 -> H1 -> H2 -> 1 sub-network, weights as in mlp_hd.h: per layer
+// W [out][in] row-major, then b [out].
+template <int H1, int H2>
+__device__ __forceinline__ float subnet_fixed(const float* __restrict__ w, const float in[4]) {
+    float h1[H1], h2[H2];
+#pragma unroll
+    for (int r = 0; r < H1; ++r) {
+        float s = w[4 * H1 + r];
+#pragma unroll
+        for (int c = 0; c < 4; ++c)
+            s = fmaf(w[r * 4 + c], in[c], s);
+        h1[r] = fast_activation(s);
+    }
+    const float* w1 = w + 5 * H1;
+#pragma unroll
+    for (int r = 0; r < H2; ++r) {
+        float s = w1[H2 * H1 + r];
+#pragma unroll
+        for (int c = 0; c < H1; ++c)
+            s = fmaf(w1[r * H1 + c], h1[c], s);
+        h2[r] = fast_activation(s);
+    }
+    const float* w2 = w1 + H2 * H1 + H2;
+    float s = w2[H2];
+#pragma unroll
+    for (int c = 0; c < H2; ++c)
+        s = fmaf(w2[c], h2[c], s);
+    return fast_activation(s);
+}
+
+__device__ __forceinline__ glm::vec3 decode_fast(const MlpHD& m, const float enc[4]) {
+    const float mm = (enc[3] - kEncodeOffset) * (1.0f / kEncodeScale);
+    if (!(mm > 0.0f))
+        return glm::vec3(0.0f);
+    const float n = m.brightness == kBrightnessSeed ? mm * m.max_n : m.max_n * __expf(m.log_range * (mm - 1.0f));
+    return glm::vec3(decode_unit(enc[0]) * n, decode_unit(enc[1]) * n, decode_unit(enc[2]) * n);
+}
+
+// The seed topology: 4 independent 4-8-4-1 sub-networks, 81 weights each.
+__device__ __forceinline__ glm::vec3 seed_network(const MlpHD& m, const float in[4]) {
+    float enc[4];
+#pragma unroll
+    for (int s = 0; s < 4; ++s)
+        enc[s] = subnet_fixed<8, 4>(c_weights + s * 81, in);
+    return decode_fast(m, enc);
+}
+
+__device__ __forceinline__ glm::vec3 generic_network(MlpHD m, const float* weights, const float in[4]) {
+    m.weights = weights;
+    float enc[kOutputs];
+    mlp_forward(m, in, enc);
+    return decode_sky(m, enc);
+}
+
+template <bool Fixed>
+__global__ void neural_kernel(MlpHD m, const float* weights, const SkySample* samples, glm::vec3* out,
+                              std::size_t n) {
+    const std::size_t i = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= n)
+        return;
+    const SkySample s = samples[i];
+    const float in[4] = {s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density};
+    out[i] = Fixed ? seed_network(m, in) : generic_network(m, weights, in);
+}
+
+// Throughput: inputs from a hash of the index, a checksum per thread.
+__device__ __forceinline__ float hash01(std::uint32_t x) {
+    x ^= x >> 16;
+    x *= 0x7feb352dU;
+    x ^= x >> 15;
+    x *= 0x846ca68bU;
+    x ^= x >> 16;
+    return float(x >> 8) * (1.0f / 16777216.0f);
+}
+
+template <bool Fixed>
+__global__ void throughput_kernel(MlpHD m, const float* weights, std::uint64_t n, float* checksum) {
+    float acc = 0.0f;
+    const std::uint64_t stride = std::uint64_t(gridDim.x) * blockDim.x;
+    for (std::uint64_t i = std::uint64_t(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) {
+        const std::uint32_t k = std::uint32_t(i);
+        const float in[4] = {2.0f * hash01(k) - 1.0f, 2.0f * hash01(k + 0x9e3779b9U) - 1.0f,
+                             2.0f * hash01(k + 0x3c6ef372U) - 1.0f, hash01(k + 0xdaa66d2bU)};
+        const glm::vec3 c = Fixed ? seed_network(m, in) : generic_network(m, weights, in);
+        acc += c.x + c.y + c.z;
+    }
+    atomicAdd(checksum, acc);
+}
+
+bool is_seed_topology(const MlpHD& m) {
+    return m.subnets == 4 && m.layers == 3 && m.width[0] == 4 && m.width[1] == 8 && m.width[2] == 4 &&
+           m.width[3] == 1 && m.subnet_params == 81;
+}
+
+// Puts the weights where the kernels read them: constant memory when they fit
+// (returns nullptr), else a device buffer (returns its pointer).
+const float* place_weights(const NeuralSky& net, cuda::DeviceBuffer<float>& global) {
+    if (net.weights.size() <= std::size_t(kConstantFloats)) {
+        SKYBAKE_CUDA_CHECK(cudaMemcpyToSymbol(c_weights, net.weights.data(), net.weights.size() * sizeof(float)));
+        float* p = nullptr;
+        SKYBAKE_CUDA_CHECK(cudaGetSymbolAddress(reinterpret_cast<void**>(&p), c_weights));
+        return p;
+    }
+    global.upload(net.weights.data(), net.weights.size());
+    return global.data();
+}
+
+} // namespace
+
+GpuThroughput measure_neural_sky_cuda(const NeuralSky& net, std::uint64_t samples, bool force_generic) {
+    require_cuda_device("--device cuda");
+    const MlpHD m = make_mlp_hd(net);
+    cuda::DeviceBuffer<float> global;
+    const float* weights = place_weights(net, global);
+    const bool fixed = is_seed_topology(m) && !force_generic;
+    cuda::DeviceBuffer<float> checksum(1);
+    SKYBAKE_CUDA_CHECK(cudaMemset(checksum.data(), 0, sizeof(float)));
+    int sms = 0;
+    SKYBAKE_CUDA_CHECK(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, 0));
+    const unsigned grid = unsigned(sms) * 16;
+    auto launch = [&] {
+        if (fixed)
+            throughput_kernel<true><<<grid, kBlock>>>(m, weights, samples, checksum.data());
+        else
+            throughput_kernel<false><<<grid, kBlock>>>(m, weights, samples, checksum.data());
+    };
+    launch(); // warm up
+    SKYBAKE_CUDA_CHECK(cudaGetLastError());
+    cudaEvent_t start, stop;
+    SKYBAKE_CUDA_CHECK(cudaEventCreate(&start));
+    SKYBAKE_CUDA_CHECK(cudaEventCreate(&stop));
+    SKYBAKE_CUDA_CHECK(cudaEventRecord(start));
+    launch();
+    SKYBAKE_CUDA_CHECK(cudaEventRecord(stop));
+    SKYBAKE_CUDA_CHECK(cudaEventSynchronize(stop));
+    float ms = 0.0f;
+    SKYBAKE_CUDA_CHECK(cudaEventElapsedTime(&ms, start, stop));
+    cudaEventDestroy(start);
+    cudaEventDestroy(stop);
+    float sum = 0.0f;
+    checksum.download(&sum, 1);
+    SKYBAKE_CUDA_CHECK(cudaDeviceSynchronize());
+    GpuThroughput t;
+    t.seconds = double(ms) * 1e-3;
+    t.samples_per_second = t.seconds > 0.0 ? double(samples) / t.seconds : 0.0;
+    t.fixed_path = fixed;
+    t.checksum = sum;
+    return t;
+}
+
+} // namespace skybake::neural
+
+namespace skybake {
+
+void evaluate_neural_sky_cuda(const NeuralSky& net, std::span<const SkySample> samples, std::span<glm::vec3> out) {
+    using namespace neural;
+    require_cuda_device("--device cuda");
+    if (samples.size() != out.size())
+        throw Error("evaluate_neural_sky_cuda: output size differs from the sample count");
+    if (samples.empty())
+        return;
+    const MlpHD m = make_mlp_hd(net);
+    cuda::DeviceBuffer<float> global;
+    const float* weights = place_weights(net, global);
+    const bool fixed = is_seed_topology(m);
+    const std::size_t chunk = std::min<std::size_t>(samples.size(), std::size_t(1) << 24);
+    cuda::DeviceBuffer<SkySample> d_in(chunk);
+    cuda::DeviceBuffer<glm::vec3> d_out(chunk);
+    for (std::size_t begin = 0; begin < samples.size(); begin += chunk) {
+        const std::size_t n = std::min(chunk, samples.size() - begin);
+        d_in.upload(samples.data() + begin, n);
+        if (fixed)
+            neural_kernel<true><<<cuda::grid_for(n, kBlock), kBlock>>>(m, weights, d_in.data(), d_out.data(), n);
+        else
+            neural_kernel<false><<<cuda::grid_for(n, kBlock), kBlock>>>(m, weights, d_in.data(), d_out.data(), n);
+        SKYBAKE_CUDA_CHECK(cudaGetLastError());
+        d_out.download(out.data() + begin, n);
+        SKYBAKE_CUDA_CHECK(cudaDeviceSynchronize());
+    }
+}
+
+} // namespace skybake

@@ -1,0 +1,96 @@
+// The CUDA network against the CPU inference. Skips without a GPU.
+// Metric: relative difference per sample, |gpu - cpu| / max(|cpu|, tiny).
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "neural/neural_cuda.h"
+#include "skybake/core.h"
+#include "skybake/error.h"
+#include "skybake/neural.h"
+
+using namespace skybake;
+
+namespace {
+// A network with fixed pseudo-random weights (not trained: the kernels must
+// agree whatever the weights are).
+NeuralSky random_network(const char* topology, unsigned seed) {
+    NeuralSky net;
+    net.topology = parse_topology(topology);
+    net.atmosphere = atmosphere_preset("earth");
+    net.encoding.max_n = 0.05;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.5f, 1.5f);
+    net.weights.resize(std::size_t(net.topology.weight_count()));
+    for (float& w : net.weights)
+        w = u(rng);
+    net.validate();
+    return net;
+}
+
+// Samples whose brightness output sits within 1e-4 of the night threshold
+// (0.05) are left out: there a last-bit difference switches between night
+// (0) and a faint sky, which no relative metric can compare.
+double worst_relative(const NeuralSky& net, const std::vector<SkySample>& samples, const std::vector<glm::vec3>& cpu,
+                      const std::vector<glm::vec3>& gpu) {
+    double worst = 0.0;
+    for (std::size_t i = 0; i < cpu.size(); ++i) {
+        float enc[4];
+        neural_sky_encoded(net, samples[i], enc);
+        if (std::abs(enc[3] - 0.05f) < 1e-4f)
+            continue;
+        const double ref = std::max({double(cpu[i].x), double(cpu[i].y), double(cpu[i].z), 1e-9});
+        for (int c = 0; c < 3; ++c)
+            worst = std::max(worst, std::abs(double(gpu[i][c]) - double(cpu[i][c])) / ref);
+    }
+    return worst;
+}
+} // namespace
+
+TEST(NeuralCuda, WithoutADeviceTheErrorIsClear) {
+    if (cuda_device_count() > 0)
+        GTEST_SKIP() << "a CUDA device is present";
+    const NeuralSky net = random_network("paper", 1);
+    std::vector<SkySample> s(4);
+    std::vector<glm::vec3> out(4);
+    EXPECT_THROW(evaluate_neural_sky_cuda(net, s, out), Error);
+    EXPECT_THROW(neural::measure_neural_sky_cuda(net, 1000), Error);
+}
+
+TEST(NeuralCuda, SeedTopologyMatchesTheCpu) {
+    if (cuda_device_count() == 0)
+        GTEST_SKIP() << "no CUDA device";
+    for (unsigned seed : {1u, 2u, 3u}) {
+        const NeuralSky net = random_network("paper", seed);
+        const auto samples = draw_sky_samples(100000, seed);
+        std::vector<glm::vec3> cpu(samples.size()), gpu(samples.size());
+        evaluate_neural_sky(net, samples, cpu);
+        evaluate_neural_sky_cuda(net, samples, gpu);
+        EXPECT_LT(worst_relative(net, samples, cpu, gpu), 1e-5) << "seed " << seed;
+    }
+}
+
+TEST(NeuralCuda, GenericTopologiesMatchTheCpu) {
+    if (cuda_device_count() == 0)
+        GTEST_SKIP() << "no CUDA device";
+    // 16x16 fits constant memory; shared:128x128x128 (about 33k weights) does not.
+    for (const char* topology : {"independent:16x16", "shared:32x32", "shared:128x128x128"}) {
+        const NeuralSky net = random_network(topology, 5);
+        const auto samples = draw_sky_samples(20000, 9);
+        std::vector<glm::vec3> cpu(samples.size()), gpu(samples.size());
+        evaluate_neural_sky(net, samples, cpu);
+        evaluate_neural_sky_cuda(net, samples, gpu);
+        EXPECT_LT(worst_relative(net, samples, cpu, gpu), 1e-5) << topology;
+    }
+}
+
+TEST(NeuralCuda, ThroughputKernelRuns) {
+    if (cuda_device_count() == 0)
+        GTEST_SKIP() << "no CUDA device";
+    const auto t = neural::measure_neural_sky_cuda(random_network("paper", 1), 1 << 20);
+    EXPECT_TRUE(t.fixed_path);
+    EXPECT_GT(t.samples_per_second, 0.0);
+    EXPECT_TRUE(std::isfinite(t.checksum));
+}
