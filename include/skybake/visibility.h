@@ -8,7 +8,8 @@
 // [SECTION] Backends
 //
 // One interface, several backends (docs/baking.md):
-//   "embree"  Intel Embree 3 on the CPU, TBB-parallel, 16-ray packets (default)
+//   "embree"  Intel Embree 3 on the CPU, TBB-parallel (default): 16-ray packets
+//             for rules of 1000+ directions, single rays for smaller ones
 //   "brute"   every ray against every triangle, in double precision: a test
 //             oracle for small meshes only
 //   "cuda"    not in this build yet: asking for it is an error
