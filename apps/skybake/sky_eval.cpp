@@ -87,7 +87,7 @@ void add_sky_eval(CLI::App& group) {
     struct Opts {
         AtmosphereFlags atm;
         ModelFlag model;
-        std::string method = "tables", input, output;
+        std::string method = "tables", input, output, device = "cpu";
         int steps = 16, shells = 256, cosines = 128;
         bool uniform = false, json = false;
     };
@@ -98,6 +98,7 @@ void add_sky_eval(CLI::App& group) {
     sub->add_option("--input", o->input, "CSV rows: cos_view_zenith,cos_view_sun,cos_sun_zenith,density")->required();
     sub->add_option("--output", o->output, "CSV rows r,g,b: radiance per unit sun irradiance, 1/sr")->required();
     sub->add_option("--steps", o->steps, "Steps of the sum along each view ray (default 16)");
+    sub->add_option("--device", o->device, "cpu (default) or cuda (tables method and networks)");
     sub->add_flag("--uniform-steps", o->uniform, "Use the seed's uniform step length instead of graded steps");
     sub->add_option("--shells", o->shells, "Table rows n (default 256)");
     sub->add_option("--cosines", o->cosines, "Table columns m (default 128)");
@@ -106,6 +107,13 @@ void add_sky_eval(CLI::App& group) {
         const bool neural = o->model.active();
         const NeuralSky net = neural ? o->model.load(*sub, o->atm) : NeuralSky{};
         const SkyMethod method = neural ? SkyMethod::Tables : parse_sky_method(o->method);
+        const Device device = parse_device(o->device);
+        if (device == Device::Cuda) {
+            require_cuda_device("--device cuda");
+            if (method == SkyMethod::Exact)
+                throw Error("the exact method runs on the CPU only; use --device cpu or --method tables",
+                            "--device cuda");
+        }
         const Atmosphere atm = neural ? net.atmosphere : o->atm.load();
         const std::vector<SkySample> samples = read_samples(o->input);
         SkyModelOptions opts;
@@ -114,8 +122,12 @@ void add_sky_eval(CLI::App& group) {
         opts.tables = {o->shells, o->cosines};
         const auto t0 = std::chrono::steady_clock::now();
         std::vector<glm::vec3> out(samples.size());
-        if (neural)
+        if (neural && device == Device::Cuda)
+            evaluate_neural_sky_cuda(net, samples, out);
+        else if (neural)
             evaluate_neural_sky(net, samples, out);
+        else if (device == Device::Cuda)
+            evaluate_sky_cuda(SkyModel(atm, opts), samples, out);
         else
             evaluate_sky(SkyModel(atm, opts), samples, out, method);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -125,10 +137,11 @@ void add_sky_eval(CLI::App& group) {
                 f << fmt::format("{:.9g},{:.9g},{:.9g}\n", c.x, c.y, c.z);
         });
         const std::string method_name = neural ? "neural" : o->method;
-        info("{} samples, {} method, {:.3f} s -> {}", samples.size(), method_name, seconds, o->output);
+        info("{} samples, {} method on {}, {:.3f} s -> {}", samples.size(), method_name, o->device, seconds, o->output);
         if (o->json)
             print_json({{"atmosphere", atm.name},
                         {"method", method_name},
+                        {"device", o->device},
                         {"model", o->model.path},
                         {"samples", samples.size()},
                         {"steps", o->steps},

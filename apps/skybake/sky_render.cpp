@@ -39,6 +39,7 @@ void add_sky_render(CLI::App& group) {
         bool has_azimuth = false, no_sun = false, json = false;
         int steps = 16;
         std::string ground = "lambert";
+        std::string device = "cpu";
     };
     auto o = std::make_shared<Opts>();
     o->atm.add(*sub);
@@ -55,6 +56,7 @@ void add_sky_render(CLI::App& group) {
     sub->add_option("-o,--output", o->output, "Output image: .png (tone-mapped sRGB) or .exr (linear)")->required();
     sub->add_option("--method", o->method, "tables (default) or exact (slow)");
     sub->add_option("--steps", o->steps, "Steps of the sum per view ray (default 16)");
+    sub->add_option("--device", o->device, "cpu (default) or cuda (tables method and networks)");
     sub->add_option("--exposure", o->exposure, "PNG exposure in stops (default: automatic)");
     sub->add_option("--tone", o->tone, "PNG tone curve: aces, reinhard or clamp");
     sub->add_flag("--no-sun", o->no_sun, "Do not draw the sun disc");
@@ -64,6 +66,9 @@ void add_sky_render(CLI::App& group) {
         const bool neural = o->model.active();
         const NeuralSky net = neural ? o->model.load(*sub, o->atm) : NeuralSky{};
         const Atmosphere atm = neural ? net.atmosphere : o->atm.load();
+        const Device device = parse_device(o->device);
+        if (device == Device::Cuda)
+            require_cuda_device("--device cuda");
         if (o->view == "fisheye")
             o->s.view = SkyView::Fisheye;
         else if (o->view == "panorama")
@@ -87,7 +92,9 @@ void add_sky_render(CLI::App& group) {
         opts.steps = o->steps;
         const auto t0 = std::chrono::steady_clock::now();
         const SkyModel model = neural ? neural_reference_model(net) : SkyModel(atm, opts);
-        const Image img = neural ? render_neural_sky(net, model, o->s) : render_sky(model, o->s);
+        const bool gpu = device == Device::Cuda;
+        const Image img = neural ? (gpu ? render_neural_sky_cuda(net, model, o->s) : render_neural_sky(net, model, o->s))
+                                 : (gpu ? render_sky_cuda(model, o->s) : render_sky(model, o->s));
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         tm.exposure_ev = std::isfinite(o->exposure) ? float(o->exposure) : float(auto_exposure(img));
         save_image(o->output, img, tm);
@@ -103,6 +110,7 @@ void add_sky_render(CLI::App& group) {
                         {"method", neural ? std::string("neural") : o->method},
                         {"model", o->model.path},
                         {"ground", o->ground},
+                        {"device", o->device},
                         {"exposure_ev", tm.exposure_ev},
                         {"seconds", seconds},
                         {"output", o->output}});

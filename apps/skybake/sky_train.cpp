@@ -12,7 +12,7 @@ void add_sky_train(CLI::App& group) {
     struct Opts {
         AtmosphereFlags atm;
         NeuralTrainOptions t;
-        std::string topology = "paper", brightness = "log", output, curve, chart;
+        std::string topology = "paper", brightness = "log", output, curve, chart, device = "cpu";
         double log_range_decades = 6.0;
         int steps = 16;
         bool json = false;
@@ -34,11 +34,15 @@ void add_sky_train(CLI::App& group) {
     sub->add_option("--heldout", o->t.heldout_samples, "Held-out samples for the learning curve (default 20000)");
     sub->add_option("--seed", o->t.seed, "Random seed (default 1)");
     sub->add_option("--steps", o->steps, "Steps of the sky model's sum for the targets (default 16)");
+    sub->add_option("--device", o->device, "Where the training targets are computed: cpu (default) or cuda");
     sub->add_option("--curve", o->curve, "Write the learning curve as CSV");
     sub->add_option("--chart", o->chart, "Write the learning curve as a PNG chart");
     sub->add_option("-o,--output", o->output, "Weights file (JSON)")->required();
     add_json_flag(*sub, o->json);
     sub->callback([o] {
+        o->t.device = parse_device(o->device);
+        if (o->t.device == Device::Cuda)
+            require_cuda_device("--device cuda");
         const Atmosphere atm = o->atm.load();
         o->t.topology = parse_topology(o->topology);
         if (o->brightness == "log")

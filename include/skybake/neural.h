@@ -26,6 +26,7 @@
 #include <glm/vec3.hpp>
 
 #include "skybake/image.h"
+#include "skybake/core.h"
 #include "skybake/sky.h"
 
 namespace skybake {
@@ -175,6 +176,10 @@ struct NeuralTrainOptions {
     int lm_iterations = 30;                  // Levenberg–Marquardt iterations; 0 skips it
     std::size_t lm_samples = 0;              // rows of the LM least squares; 0: automatic
     bool progress = true;                    // progress bar on stderr (TTY only)
+    // Where the training targets are computed: Device::Cuda runs the sky
+    // model's table path on the GPU (evaluate_sky_cuda); the optimiser runs
+    // on the CPU either way.
+    Device device = Device::Cpu;
 };
 
 // One point of the learning curve: after Adam epoch `epoch` (phase "adam") or
@@ -276,6 +281,8 @@ std::vector<SeedView> seed_views(int width, int height);
 // from the tables of `tables` (section IV; build it with neural_reference_model).
 // settings.method is ignored.
 Image render_neural_sky(const NeuralSky& net, const SkyModel& tables, const SkyRenderSettings& settings);
+// The same on CUDA device 0 (same per-pixel code); throws without CUDA or a device.
+Image render_neural_sky_cuda(const NeuralSky& net, const SkyModel& tables, const SkyRenderSettings& settings);
 
 // Exposure (stops) that maps the 98th percentile of luminance to 1 (as `sky render`).
 double auto_exposure_ev(const Image& image);

@@ -13,6 +13,7 @@
 #include "neural/internal.h"
 #include "neural/mlp_hd.h"
 #include "neural/neural_cuda.h"
+#include "neural/render_hd.h"
 #include "sky/internal.h"
 #include "skybake/core.h"
 
@@ -128,6 +129,20 @@ __global__ void throughput_kernel(MlpHD m, const float* weights, std::uint64_t n
     atomicAdd(checksum, acc);
 }
 
+__global__ void neural_render_kernel(sky::RenderHD p, MlpHD m, const float* weights, float* rgb) {
+    const int x = int(blockIdx.x * blockDim.x + threadIdx.x), y = int(blockIdx.y * blockDim.y + threadIdx.y);
+    if (x >= p.width || y >= p.height)
+        return;
+    m.weights = weights;
+    glm::vec3 d, c(0.0f);
+    if (sky::pixel_direction(p, x, y, d))
+        c = shade_ray_neural(p, m, d);
+    float* px = rgb + (std::size_t(y) * std::size_t(p.width) + std::size_t(x)) * 3;
+    px[0] = c.x;
+    px[1] = c.y;
+    px[2] = c.z;
+}
+
 bool is_seed_topology(const MlpHD& m) {
     return m.subnets == 4 && m.layers == 3 && m.width[0] == 4 && m.width[1] == 8 && m.width[2] == 4 &&
            m.width[3] == 1 && m.subnet_params == 81;
@@ -218,6 +233,32 @@ void evaluate_neural_sky_cuda(const NeuralSky& net, std::span<const SkySample> s
         d_out.download(out.data() + begin, n);
         SKYBAKE_CUDA_CHECK(cudaDeviceSynchronize());
     }
+}
+
+Image render_neural_sky_cuda(const NeuralSky& net, const SkyModel& model, const SkyRenderSettings& settings) {
+    using namespace neural;
+    net.validate("neural sky");
+    sky::RenderHD p = sky::make_render_hd(model, settings);
+    require_cuda_device("--device cuda");
+    // The tables (for the ground and the sun) on the device.
+    std::vector<cuda::DeviceBuffer<float>> tables(std::size_t(p.atm.count));
+    for (int k = 0; k < p.atm.count; ++k) {
+        const std::size_t n = std::size_t(p.atm.comp[k].table.rows) * std::size_t(p.atm.comp[k].table.cols);
+        tables[std::size_t(k)].upload(p.atm.comp[k].table.L, n);
+        p.atm.comp[k].table.L = tables[std::size_t(k)].data();
+    }
+    const MlpHD m = make_mlp_hd(net);
+    cuda::DeviceBuffer<float> global;
+    const float* weights = place_weights(net, global);
+    Image image(settings.width, settings.height);
+    cuda::DeviceBuffer<float> d_rgb(image.rgb.size());
+    const dim3 block(16, 8);
+    const dim3 grid(cuda::grid_for(std::size_t(p.width), block.x), cuda::grid_for(std::size_t(p.height), block.y));
+    neural_render_kernel<<<grid, block>>>(p, m, weights, d_rgb.data());
+    SKYBAKE_CUDA_CHECK(cudaGetLastError());
+    d_rgb.download(image.rgb.data(), image.rgb.size());
+    SKYBAKE_CUDA_CHECK(cudaDeviceSynchronize());
+    return image;
 }
 
 } // namespace skybake

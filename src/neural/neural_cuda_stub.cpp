@@ -9,6 +9,11 @@ void evaluate_neural_sky_cuda(const NeuralSky&, std::span<const SkySample>, std:
     require_cuda_device("--device cuda"); // throws
 }
 
+Image render_neural_sky_cuda(const NeuralSky&, const SkyModel&, const SkyRenderSettings&) {
+    require_cuda_device("--device cuda"); // throws
+    return {};
+}
+
 namespace neural {
 GpuThroughput measure_neural_sky_cuda(const NeuralSky&, std::uint64_t, bool) {
     require_cuda_device("--device cuda"); // throws

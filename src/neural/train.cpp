@@ -57,11 +57,20 @@ struct DataSet {
     std::size_t size() const { return radiance.size(); }
 };
 
-DataSet make_data(const SkyModel& model, const NeuralEncoding& enc, std::size_t n, std::uint64_t seed) {
+// Training targets from the sky model's table path, on the CPU or the GPU.
+void sky_targets(const SkyModel& model, std::span<const SkySample> s, std::span<glm::vec3> out, Device device) {
+    if (device == Device::Cuda)
+        evaluate_sky_cuda(model, s, out);
+    else
+        evaluate_sky(model, s, out, SkyMethod::Tables);
+}
+
+DataSet make_data(const SkyModel& model, const NeuralEncoding& enc, std::size_t n, std::uint64_t seed,
+                  Device device) {
     DataSet d;
     const std::vector<SkySample> s = draw_sky_samples(n, seed);
     d.radiance.resize(n);
-    evaluate_sky(model, s, d.radiance, SkyMethod::Tables);
+    sky_targets(model, s, d.radiance, device);
     d.x = samples_to_matrix(s);
     encode_targets(enc, d.radiance, d.t, d.mask);
     d.mask_count = double(d.mask.sum());
@@ -246,7 +255,7 @@ NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, s
     {   // max{N} over random samples (the seed's 100,000)
         const std::vector<SkySample> s = draw_sky_samples(o.max_n_samples, stream_seed(o.seed, 2));
         std::vector<glm::vec3> r(s.size());
-        evaluate_sky(model, s, r, SkyMethod::Tables);
+        sky_targets(model, s, r, o.device);
         double mx = 0.0;
         for (const glm::vec3& c : r)
             mx = std::max(mx, double(std::max({c.x, c.y, c.z})));
@@ -255,8 +264,8 @@ NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, s
                         "atmosphere");
         net.encoding.max_n = mx;
     }
-    const DataSet train = make_data(model, net.encoding, o.samples, stream_seed(o.seed, 0));
-    const DataSet held = make_data(model, net.encoding, o.heldout_samples, stream_seed(o.seed, 1));
+    const DataSet train = make_data(model, net.encoding, o.samples, stream_seed(o.seed, 0), o.device);
+    const DataSet held = make_data(model, net.encoding, o.heldout_samples, stream_seed(o.seed, 1), o.device);
 
     const Layout lay = make_layout(net.topology);
     net.weights = initial_weights(lay, stream_seed(o.seed, 3));
