@@ -171,16 +171,27 @@ Mesh city(std::uint64_t target, std::uint64_t seed) {
     b.grid(g, g, [&](double u, double v) -> PN {
         return {glm::vec3(float(-1 + 2 * u), 0.0f, float(1 - 2 * v)), glm::vec3(0, 1, 0)};
     });
-    const int clusters = 6;
+    // Buildings on a jittered grid, one per cell, so that they never overlap;
+    // heights cluster around a few "downtown" centres.
+    const int cells = std::max(1, int(std::ceil(std::sqrt(double(boxes)))));
+    const double cell = 1.9 / cells;
+    const int clusters = 5;
+    double cx[clusters], cz[clusters];
+    for (int k = 0; k < clusters; ++k) {
+        cx[k] = -0.7 + 1.4 * hash01(seed, 1, k);
+        cz[k] = -0.7 + 1.4 * hash01(seed, 2, k);
+    }
     for (std::uint64_t i = 0; i < boxes; ++i) {
-        const auto k = std::int64_t(i % clusters);
-        const double cx = -0.7 + 1.4 * hash01(seed, 1, k), cz = -0.7 + 1.4 * hash01(seed, 2, k);
-        // Box-Muller for a clustered, Gaussian spread around the centre.
-        const double r = 0.18 * std::sqrt(-2.0 * std::log(1e-12 + hash01(seed, 3, std::int64_t(i))));
-        const double a = 2 * kPi * hash01(seed, 4, std::int64_t(i));
-        const double x = std::clamp(cx + r * std::cos(a), -0.95, 0.95), z = std::clamp(cz + r * std::sin(a), -0.95, 0.95);
-        const double w = 0.01 + 0.03 * hash01(seed, 5, std::int64_t(i)), d = 0.01 + 0.03 * hash01(seed, 6, std::int64_t(i));
-        const double h = 0.02 + 0.25 * std::pow(hash01(seed, 7, std::int64_t(i)), 2.0);
+        const auto gi = std::int64_t(i % std::uint64_t(cells)), gj = std::int64_t(i / std::uint64_t(cells));
+        const double x0 = -0.95 + cell * double(gi), z0 = -0.95 + cell * double(gj);
+        const auto id = std::int64_t(i);
+        const double w = cell * (0.25 + 0.2 * hash01(seed, 5, id)), d = cell * (0.25 + 0.2 * hash01(seed, 6, id));
+        const double x = x0 + cell * 0.5 + (cell * 0.5 - w) * (2 * hash01(seed, 3, id) - 1);
+        const double z = z0 + cell * 0.5 + (cell * 0.5 - d) * (2 * hash01(seed, 4, id) - 1);
+        double near2 = 1e9;
+        for (int k = 0; k < clusters; ++k)
+            near2 = std::min(near2, (x - cx[k]) * (x - cx[k]) + (z - cz[k]) * (z - cz[k]));
+        const double h = 0.01 + (0.04 + 0.3 * std::exp(-near2 / 0.03)) * (0.3 + 0.7 * hash01(seed, 7, id));
         add_box(b, glm::vec3(float(x - w), 0.0f, float(z - d)), glm::vec3(float(x + w), float(h), float(z + d)));
     }
     return std::move(b.mesh);
