@@ -8,25 +8,6 @@
 
 namespace skybake::cli {
 
-namespace {
-
-// Exposure (stops) that maps the 98th percentile of luminance to 1.
-double auto_exposure(const Image& img) {
-    std::vector<float> lum;
-    lum.reserve(img.rgb.size() / 3);
-    for (std::size_t i = 0; i + 2 < img.rgb.size(); i += 3) {
-        const float l = 0.2126f * img.rgb[i] + 0.7152f * img.rgb[i + 1] + 0.0722f * img.rgb[i + 2];
-        if (l > 0.0f && std::isfinite(l))
-            lum.push_back(l);
-    }
-    if (lum.empty())
-        return 0.0;
-    const std::size_t k = std::min(lum.size() - 1, std::size_t(double(lum.size()) * 0.98));
-    std::nth_element(lum.begin(), lum.begin() + std::ptrdiff_t(k), lum.end());
-    return -std::log2(double(lum[k]));
-}
-
-} // namespace
 
 void add_sky_render(CLI::App& group) {
     auto* sub = group.add_subcommand("render", "Render the sky, the ground and the planet (PNG or EXR)");
@@ -96,7 +77,7 @@ void add_sky_render(CLI::App& group) {
         const Image img = neural ? (gpu ? render_neural_sky_cuda(net, model, o->s) : render_neural_sky(net, model, o->s))
                                  : (gpu ? render_sky_cuda(model, o->s) : render_sky(model, o->s));
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        tm.exposure_ev = std::isfinite(o->exposure) ? float(o->exposure) : float(auto_exposure(img));
+        tm.exposure_ev = std::isfinite(o->exposure) ? float(o->exposure) : float(auto_exposure_ev(img));
         save_image(o->output, img, tm);
         info("{}x{} {} view from {} km, sun at {} deg: {:.2f} s -> {} (exposure {:+.2f} EV)", o->s.width, o->s.height,
              o->view, o->s.altitude_km, o->s.sun_elevation_deg, seconds, o->output, tm.exposure_ev);

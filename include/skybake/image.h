@@ -52,6 +52,10 @@ float tone_map_value(float linear, const ToneMap& tm);
 float linear_to_srgb(float linear);
 float srgb_to_linear(float encoded);
 
+// Exposure in stops that maps the 98th percentile of the image's luminance
+// (Rec. 709 weights, positive finite pixels) to 1; 0 for a black image.
+double auto_exposure_ev(const Image& image);
+
 // Linear float image -> 8-bit sRGB, 3 bytes per pixel.
 std::vector<std::uint8_t> to_srgb8(const Image& image, const ToneMap& tm = {});
 

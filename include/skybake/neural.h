@@ -284,8 +284,6 @@ Image render_neural_sky(const NeuralSky& net, const SkyModel& tables, const SkyR
 // The same on CUDA device 0 (same per-pixel code); throws without CUDA or a device.
 Image render_neural_sky_cuda(const NeuralSky& net, const SkyModel& tables, const SkyRenderSettings& settings);
 
-// Exposure (stops) that maps the 98th percentile of luminance to 1 (as `sky render`).
-double auto_exposure_ev(const Image& image);
 // PSNR in dB of two images of the same size after tone mapping both with tm
 // and the sRGB transfer function (display values in [0, 1], not quantised).
 double image_psnr_db(const Image& reference, const Image& test, const ToneMap& tm);

@@ -76,6 +76,21 @@ float srgb_to_linear(float v) {
     return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
 }
 
+double auto_exposure_ev(const Image& img) {
+    std::vector<float> lum;
+    lum.reserve(img.rgb.size() / 3);
+    for (std::size_t i = 0; i + 2 < img.rgb.size(); i += 3) {
+        const float l = 0.2126f * img.rgb[i] + 0.7152f * img.rgb[i + 1] + 0.0722f * img.rgb[i + 2];
+        if (l > 0.0f && std::isfinite(l))
+            lum.push_back(l);
+    }
+    if (lum.empty())
+        return 0.0;
+    const std::size_t k = std::min(lum.size() - 1, std::size_t(double(lum.size()) * 0.98));
+    std::nth_element(lum.begin(), lum.begin() + std::ptrdiff_t(k), lum.end());
+    return -std::log2(double(lum[k]));
+}
+
 std::vector<std::uint8_t> to_srgb8(const Image& image, const ToneMap& tm) {
     std::vector<std::uint8_t> out(image.rgb.size());
     for (std::size_t i = 0; i < image.rgb.size(); ++i)

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "core/random.h"
 #include "skybake/error.h"
 #include "skybake/mesh.h"
 
@@ -22,12 +23,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::uint64_t splitmix64(std::uint64_t x) {
-    x += 0x9e3779b97f4a7c15ull;
-    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-    return x ^ (x >> 31);
-}
 
 // Uniform in [0, 1), from 53 bits of a hash.
 double hash01(std::uint64_t seed, std::int64_t a, std::int64_t b = 0, std::int64_t c = 0) {

@@ -66,21 +66,6 @@ std::vector<SeedView> seed_views(int width, int height) {
             view("5_low_sun", 0.0, 2.0, 0.0, 10.0, 0.0),       view("6_very_high", 1500.0, 35.0, 40.0, -70.0, 0.0)};
 }
 
-double auto_exposure_ev(const Image& img) {
-    std::vector<float> lum;
-    lum.reserve(img.rgb.size() / 3);
-    for (std::size_t i = 0; i + 2 < img.rgb.size(); i += 3) {
-        const float l = 0.2126f * img.rgb[i] + 0.7152f * img.rgb[i + 1] + 0.0722f * img.rgb[i + 2];
-        if (l > 0.0f && std::isfinite(l))
-            lum.push_back(l);
-    }
-    if (lum.empty())
-        return 0.0;
-    const std::size_t k = std::min(lum.size() - 1, std::size_t(double(lum.size()) * 0.98));
-    std::nth_element(lum.begin(), lum.begin() + std::ptrdiff_t(k), lum.end());
-    return -std::log2(double(lum[k]));
-}
-
 double image_psnr_db(const Image& a, const Image& b, const ToneMap& tm) {
     if (a.width != b.width || a.height != b.height || a.rgb.size() != b.rgb.size())
         throw Error("images of different sizes", "PSNR");

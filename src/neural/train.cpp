@@ -23,6 +23,7 @@
 #include "core/progress.h"
 #include "neural/internal.h"
 #include "skybake/core.h"
+#include "core/random.h"
 #include "skybake/error.h"
 
 namespace skybake {
@@ -31,17 +32,7 @@ using namespace neural;
 
 namespace {
 
-// SplitMix64 (Steele, Lea, Flood 2014).
-struct SplitMix {
-    std::uint64_t state;
-    std::uint64_t next() {
-        std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    double uniform() { return double(next() >> 11) * 0x1.0p-53; } // [0, 1)
-};
+using SplitMix = SplitMix64;
 
 std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t stream) {
     SplitMix r{seed ^ (stream * 0xA0761D6478BD642Full)};

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "core/parallel.h"
+#include "core/random.h"
 #include "skybake/error.h"
 #include "skybake/sky.h"
 
@@ -52,17 +53,7 @@ void check_sky_sample(const SkySample& s, const std::string& where) {
 
 namespace {
 
-// SplitMix64 (Steele, Lea, Flood 2014): a counter-based stream per sample index.
-struct SplitMix {
-    std::uint64_t state;
-    std::uint64_t next() {
-        std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
-        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-        return z ^ (z >> 31);
-    }
-    double uniform() { return double(next() >> 11) * 0x1.0p-53; } // [0, 1)
-};
+using SplitMix = SplitMix64;
 
 } // namespace
 

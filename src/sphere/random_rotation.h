@@ -12,18 +12,12 @@
 #include <glm/mat3x3.hpp>
 
 #include "core/hd.h"
+#include "core/random.h"
 
 namespace skybake::sphere {
 
-SKYBAKE_HD_INLINE std::uint64_t splitmix64(std::uint64_t z) {
-    z += 0x9e3779b97f4a7c15ull;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
-// Uniform double in [0, 1) from 53 random bits.
-SKYBAKE_HD_INLINE double unit_double(std::uint64_t bits) { return double(bits >> 11) * (1.0 / 9007199254740992.0); }
+using skybake::splitmix64;
+using skybake::unit_double;
 
 // Rotation matrix R (apply as R * x) for one vertex; uniform over SO(3).
 template <class T>
