@@ -150,7 +150,11 @@ bool write_all(int fd, const std::string& s) {
 }
 
 [[noreturn]] void child_main(int fd, const std::function<RawImport()>& parse, const ImportLimits& limits) {
-    ::signal(SIGALRM, SIG_DFL);
+    // Die plainly on a fault: handlers inherited from the parent (a crash
+    // reporter, a sanitizer, a fuzzer) must not run in the child; the parent
+    // reports the signal as one error line.
+    for (int sig : {SIGALRM, SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT})
+        ::signal(sig, SIG_DFL);
     ::alarm(limits.parser_timeout_s > 0 ? limits.parser_timeout_s : 0);
 #if !defined(SKYBAKE_ASAN) // ASan reserves terabytes of address space for its shadow
     if (limits.parser_memory_bytes > 0) {

@@ -110,9 +110,10 @@ void precheck_for_assimp(const std::string& ext, const void* data, std::size_t s
             ++pos;
         return text.substr(start, pos - start);
     };
-    std::string_view magic = token();
-    if (magic.size() < 3 || magic.substr(magic.size() - 3) != "OFF")
-        return; // let Assimp explain
+    // Assimp accepts any first token that contains "OFF" (COFF, NOFF, OFF007, ...).
+    const std::string_view magic = token();
+    if (magic.find("OFF") == std::string_view::npos)
+        return; // not OFF: let Assimp explain
     std::uint64_t counts[2] = {0, 0};
     for (auto& c : counts) {
         const std::string_view t = token();

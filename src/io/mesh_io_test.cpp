@@ -288,6 +288,15 @@ TEST(HostileInput, PlyPartialNormalsAreIgnored) {
     EXPECT_FLOAT_EQ(m.normals[0].z, 1.0f);
 }
 
+TEST(HostileInput, OffHeaderCountsAreCheckedBeforeAssimp) {
+    // Found by the fuzzer: Assimp reads "OFF007..." as OFF and tried to
+    // allocate 39 GB for the declared faces.
+    EXPECT_THROW(load_text("OFF007577777777\n8 600000500000757777777777target77:7\n-0.5\n", "off"), Error);
+    EXPECT_THROW(load_text("OFF\n3 99999999999 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "off"), Error);
+    const Mesh ok = load_text("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "off");
+    EXPECT_EQ(ok.triangle_count(), 1u);
+}
+
 TEST(HostileInput, DegenerateTrianglesAreSkippedAndCounted) {
     const std::string ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
                             "property float z\nelement face 3\nproperty list uchar int vertex_indices\nend_header\n"
