@@ -204,9 +204,8 @@ void BM_AoVsBareEmbree(benchmark::State& state) {
     state.counters["ratio_best"] = std::min(t16, t1) / t_bake; // against the faster bare loop
 }
 
-// Args: kind, triangles. lebedev:5810.
-void BM_AoTableCase(benchmark::State& state) {
-    Scene& s = scene(int(state.range(0)), std::uint64_t(state.range(1)), "lebedev:5810", false);
+// Whole bakes of one scene (BVH build included), timed per iteration.
+void run_whole_bake(benchmark::State& state, Scene& s) {
     double build = 0, trace = 0;
     std::uint64_t rays = 0;
     for (auto _ : state) {
@@ -227,28 +226,17 @@ void BM_AoTableCase(benchmark::State& state) {
     state.counters["Mrays"] = double(rays) * it / trace * 1e-6;
 }
 
+// Args: kind, triangles. lebedev:5810.
+void BM_AoTableCase(benchmark::State& state) {
+    Scene& s = scene(int(state.range(0)), std::uint64_t(state.range(1)), "lebedev:5810", false);
+    run_whole_bake(state, s);
+}
+
 // Args: kind, triangles, Lebedev points.
 void BM_AoLargeMesh(benchmark::State& state) {
     Scene& s = scene(int(state.range(0)), std::uint64_t(state.range(1)), fmt::format("lebedev:{}", state.range(2)),
                      false);
-    double build = 0, trace = 0;
-    std::uint64_t rays = 0;
-    for (auto _ : state) {
-        BakeOutputs out;
-        const auto t0 = std::chrono::steady_clock::now();
-        s.backend.bake(s.mesh, s.rule, BakeOptions{}, out);
-        state.SetIterationTime(seconds_since(t0));
-        build += out.build_seconds;
-        trace += out.trace_seconds;
-        rays = out.rays;
-    }
-    const double it = double(state.iterations());
-    state.counters["vertices"] = double(s.mesh.vertex_count());
-    state.counters["triangles"] = double(s.mesh.triangle_count());
-    state.counters["rays"] = double(rays);
-    state.counters["build_s"] = build / it;
-    state.counters["trace_s"] = trace / it;
-    state.counters["Mrays"] = double(rays) * it / trace * 1e-6;
+    run_whole_bake(state, s);
 }
 
 } // namespace

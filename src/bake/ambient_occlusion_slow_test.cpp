@@ -18,13 +18,6 @@ using namespace skybake::ao_test;
 
 namespace {
 
-Mesh generated(ProceduralKind kind, std::uint64_t triangles) {
-    ProceduralOptions p;
-    p.kind = kind;
-    p.target_triangles = triangles;
-    return generate_mesh(p);
-}
-
 double rms_error_vs_half(const Mesh& m) {
     double s = 0.0;
     for (float x : m.find_attribute("ao")->values)

@@ -33,13 +33,6 @@ using namespace skybake::ao_test;
 
 namespace {
 
-Mesh generated(ProceduralKind kind, std::uint64_t triangles) {
-    ProceduralOptions p;
-    p.kind = kind;
-    p.target_triangles = triangles;
-    return generate_mesh(p);
-}
-
 std::filesystem::path temp_path(const std::string& name) {
     const auto dir = std::filesystem::temp_directory_path() / "skybake_bake_test";
     std::filesystem::create_directories(dir);

@@ -14,6 +14,7 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 
+#include "skybake/mesh.h"
 #include "skybake/sphere.h"
 
 namespace skybake::ao_test {
@@ -106,6 +107,14 @@ inline bool wall_visible(const glm::dvec3& p, const glm::dvec3& x, double x0, do
     const double t = (zw - p.z) / x.z;
     const double hx = p.x + t * x.x, hy = p.y + t * x.y;
     return !(hx >= x0 && hx <= x1 && hy >= 0.0 && hy <= h);
+}
+
+// A procedural mesh of about `triangles` triangles, default seed.
+inline Mesh generated(ProceduralKind kind, std::uint64_t triangles) {
+    ProceduralOptions p;
+    p.kind = kind;
+    p.target_triangles = triangles;
+    return generate_mesh(p);
 }
 
 } // namespace skybake::ao_test

@@ -25,25 +25,7 @@ Image render_neural_sky(const NeuralSky& net, const SkyModel& model, const SkyRe
     const sky::RenderHD p = sky::make_render_hd(model, s);
     const MlpHD hd = make_mlp_hd(net);
 
-    Image image(s.width, s.height);
-    Progress progress("render", std::uint64_t(s.height));
-    parallel_for(std::size_t(s.height), 1, [&](std::size_t y0, std::size_t y1) {
-        for (std::size_t y = y0; y < y1; ++y) {
-            for (int x = 0; x < s.width; ++x) {
-                glm::vec3 d;
-                if (!sky::pixel_direction(p, x, int(y), d))
-                    continue;
-                const glm::vec3 c = shade_ray_neural(p, hd, d);
-                float* px = image.pixel(x, int(y));
-                px[0] = c.x;
-                px[1] = c.y;
-                px[2] = c.z;
-            }
-            progress.advance();
-        }
-    });
-    progress.finish();
-    return image;
+    return sky::render_pixels(p, [&](const glm::vec3& d) { return shade_ray_neural(p, hd, d); });
 }
 
 std::vector<SeedView> seed_views(int width, int height) {

@@ -4,6 +4,8 @@
 #include <glm/exponential.hpp>
 #include <glm/geometric.hpp>
 
+#include "core/parallel.h"
+#include "core/progress.h"
 #include "skybake/sky.h"
 #include "sky/render_hd.h"
 #include "sky/sky_hd.h"
@@ -40,5 +42,31 @@ bool atmosphere_segment(const Atmosphere& atmosphere, const glm::dvec3& origin_k
 // Validates the settings (throws skybake::Error naming the flag) and sets up
 // the per-pixel parameters shared by the CPU and CUDA renderers.
 RenderHD make_render_hd(const SkyModel& model, const SkyRenderSettings& settings);
+
+// The CPU pixel loop: shade(dir) -> linear RGB for every pixel with a view
+// direction, rows in parallel, with a progress bar. Pixels without a
+// direction (outside the fisheye disc) stay black.
+template <class Shade>
+Image render_pixels(const RenderHD& p, Shade shade) {
+    Image image(p.width, p.height);
+    Progress progress("render", std::uint64_t(p.height));
+    parallel_for(std::size_t(p.height), 1, [&](std::size_t y0, std::size_t y1) {
+        for (std::size_t y = y0; y < y1; ++y) {
+            for (int x = 0; x < p.width; ++x) {
+                glm::vec3 d;
+                if (!pixel_direction(p, x, int(y), d))
+                    continue;
+                const glm::vec3 c = shade(d);
+                float* px = image.pixel(x, int(y));
+                px[0] = c.x;
+                px[1] = c.y;
+                px[2] = c.z;
+            }
+            progress.advance();
+        }
+    });
+    progress.finish();
+    return image;
+}
 
 } // namespace skybake::sky

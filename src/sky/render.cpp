@@ -101,28 +101,11 @@ Image render_sky(const SkyModel& model, const SkyRenderSettings& s) {
     const Atmosphere& atm = model.atmosphere();
     const sky::RenderHD p = sky::make_render_hd(model, s);
 
-    Image image(s.width, s.height);
-    Progress progress("render", std::uint64_t(s.height));
     const bool exact = s.method == SkyMethod::Exact;
     const double tol = model.options().exact_tolerance;
-    parallel_for(std::size_t(s.height), 1, [&](std::size_t y0, std::size_t y1) {
-        for (std::size_t y = y0; y < y1; ++y) {
-            for (int x = 0; x < s.width; ++x) {
-                glm::vec3 d;
-                float* px = image.pixel(x, int(y));
-                if (!sky::pixel_direction(p, x, int(y), d))
-                    continue;
-                const glm::vec3 c = exact ? glm::vec3(shade_ray_exact(atm, p, glm::normalize(glm::dvec3(d)), tol))
-                                          : sky::shade_ray(p, d);
-                px[0] = c.x;
-                px[1] = c.y;
-                px[2] = c.z;
-            }
-            progress.advance();
-        }
+    return sky::render_pixels(p, [&](const glm::vec3& d) {
+        return exact ? glm::vec3(shade_ray_exact(atm, p, glm::normalize(glm::dvec3(d)), tol)) : sky::shade_ray(p, d);
     });
-    progress.finish();
-    return image;
 }
 
 } // namespace skybake
