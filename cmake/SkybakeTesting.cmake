@@ -55,10 +55,10 @@ function(skybake_add_tests name)
   endforeach()
 endfunction()
 
-# Tests beside the sources of a module: src/NAME/*_test.cpp
+# Tests beside the sources of a module: src/NAME/**/*_test.cpp
 function(skybake_add_module_tests name)
   cmake_parse_arguments(T "" "" "LIBS" ${ARGN})
-  file(GLOB files CONFIGURE_DEPENDS
+  file(GLOB_RECURSE files CONFIGURE_DEPENDS
     ${PROJECT_SOURCE_DIR}/src/${name}/*_test.cpp ${PROJECT_SOURCE_DIR}/src/${name}/*_test.cu)
   if(files)
     skybake_add_tests(${name} FILES ${files} LIBS skybake_${name} ${T_LIBS})

@@ -12,7 +12,10 @@
 //             for rules of 1000+ directions, single rays for smaller ones
 //   "brute"   every ray against every triangle, in double precision: a test
 //             oracle for small meshes only
-//   "cuda"    not in this build yet: asking for it is an error
+//   "cuda"    NVIDIA GPUs (builds that have CUDA, machines that have a GPU): a
+//             BVH built on the CPU with Embree's builder, walked by one GPU
+//             thread per ray; visibility packed into bits on the GPU and
+//             reduced there. Also the seed's brute-force methods (TraceMethod)
 //
 // Frames and units: everything is in the mesh's world space and its own length
 // unit ("mesh units"); directions are unit vectors in the same frame.
@@ -63,6 +66,18 @@ const char* back_faces_name(BackFaces mode); // "occlude", "ignore"
 // Parses "occlude" or "ignore"; throws skybake::Error otherwise.
 BackFaces parse_back_faces(const std::string& text);
 
+// How the cuda backend finds blockers (BakeOptions::method). Every method
+// decides the same ray–triangle test on the same triangles, so all three give
+// the same bits; they differ in speed only (docs/PERFORMANCE.md).
+enum class TraceMethod : int {
+    Bvh = 0,        // "bvh": the BVH (default; the only method of the CPU backends)
+    PerVertex = 1,  // "per-vertex": the seed's naive method, every triangle for every ray
+    PerPolygon = 2, // "per-polygon": every triangle too, in tiles cached in shared memory
+};
+const char* trace_method_name(TraceMethod method); // "bvh", "per-vertex", "per-polygon"
+// Parses a name above; throws skybake::Error otherwise.
+TraceMethod parse_trace_method(const std::string& text);
+
 // [SECTION] Bake options --------------------------------------------------------------
 //
 // For every vertex p with unit normal n, and every direction x_k of a sphere
@@ -106,6 +121,8 @@ struct BakeOptions {
     bool normalize = false;
     // Keep the visibility bits (BakeOutputs::visibility_bits).
     bool store_bits = false;
+    // The cuda backend's method; the CPU backends accept only TraceMethod::Bvh.
+    TraceMethod method = TraceMethod::Bvh;
 };
 
 // The ray offset a bake uses for this mesh: options.ray_offset if ≥ 0, else
@@ -174,11 +191,12 @@ public:
     virtual void bake(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options, BakeOutputs& out);
 };
 
-// Names accepted by make_visibility_backend() in this build.
+// Names accepted by make_visibility_backend() in this build ("cuda" only in
+// builds with CUDA; it still needs a GPU at run time).
 std::vector<std::string> visibility_backend_names();
 
 // Creates a backend by name. Throws skybake::Error for an unknown name, and for
-// "cuda" until the CUDA backend exists.
+// "cuda" in a build without CUDA or on a machine without a CUDA device.
 std::unique_ptr<VisibilityBackend> make_visibility_backend(const std::string& name);
 
 // The brute-force backend refuses meshes with more triangles than this.

@@ -18,6 +18,7 @@
 #include "sphere/random_rotation.h"
 #include "visibility/bake_common.h"
 #include "visibility/brute_backend.h"
+#include "visibility/cuda/cuda_backend.h"
 #include "visibility/embree/embree_backend.h"
 #include "visibility/shading_hd.h"
 
@@ -42,7 +43,31 @@ float resolve_ray_offset(const Mesh& mesh, const BakeOptions& options) {
     return kDefaultRayOffsetScale * compute_bounds(mesh).diagonal();
 }
 
-std::vector<std::string> visibility_backend_names() { return {"embree", "brute"}; }
+const char* trace_method_name(TraceMethod method) {
+    switch (method) {
+    case TraceMethod::PerVertex: return "per-vertex";
+    case TraceMethod::PerPolygon: return "per-polygon";
+    default: return "bvh";
+    }
+}
+
+TraceMethod parse_trace_method(const std::string& text) {
+    for (TraceMethod m : {TraceMethod::Bvh, TraceMethod::PerVertex, TraceMethod::PerPolygon})
+        if (text == trace_method_name(m))
+            return m;
+    throw Error(fmt::format("unknown method '{}'; choose bvh (default), per-vertex (every triangle for every ray) or "
+                            "per-polygon (every triangle, cached in shared memory; cuda backend)",
+                            text),
+                "--method");
+}
+
+std::vector<std::string> visibility_backend_names() {
+#if defined(SKYBAKE_HAS_CUDA)
+    return {"embree", "brute", "cuda"};
+#else
+    return {"embree", "brute"};
+#endif
+}
 
 std::unique_ptr<VisibilityBackend> make_visibility_backend(const std::string& name) {
     if (name == "embree")
@@ -50,9 +75,9 @@ std::unique_ptr<VisibilityBackend> make_visibility_backend(const std::string& na
     if (name == "brute")
         return std::make_unique<visibility::BruteForceBackend>();
     if (name == "cuda")
-        throw Error("this build has no CUDA visibility backend yet; use embree (the default)", "--backend");
-    throw Error(fmt::format("unknown visibility backend '{}'; choose embree (default) or brute (a test oracle for small "
-                            "meshes)",
+        return visibility::make_cuda_backend(); // throws without CUDA or a device
+    throw Error(fmt::format("unknown visibility backend '{}'; choose embree (default), cuda (NVIDIA GPUs) or brute (a "
+                            "test oracle for small meshes)",
                             name),
                 "--backend");
 }
@@ -60,6 +85,7 @@ std::unique_ptr<VisibilityBackend> make_visibility_backend(const std::string& na
 void VisibilityBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options,
                              BakeOutputs& out) {
     using visibility::BakeSetup;
+    visibility::require_bvh_method(options, name());
     const BakeSetup s = visibility::prepare_bake(mesh, rule, options, out);
     const auto t0 = std::chrono::steady_clock::now();
     set_mesh(mesh, options.back_faces);
@@ -106,6 +132,14 @@ void VisibilityBackend::bake(const Mesh& mesh, const SphereRule& rule, const Bak
 }
 
 namespace visibility {
+
+void require_bvh_method(const BakeOptions& options, const char* backend) {
+    if (options.method != TraceMethod::Bvh)
+        throw Error(fmt::format("the {} method is the cuda backend's; the {} backend has only bvh (use --backend cuda, "
+                                "or leave --method out)",
+                                trace_method_name(options.method), backend),
+                    "--method");
+}
 
 BakeSetup prepare_bake(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options, BakeOutputs& out) {
     validate_mesh(mesh, "mesh");

@@ -43,6 +43,10 @@ struct VertexFrame {
     glm::mat3 rotation{1.0f};
 };
 
+// Throws skybake::Error unless options.method is TraceMethod::Bvh (the CPU
+// backends have no other).
+void require_bvh_method(const BakeOptions& options, const char* backend);
+
 // Checks the inputs (throws skybake::Error with a message for the user), fills
 // the setup and sizes every array of `out`.
 BakeSetup prepare_bake(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options, BakeOutputs& out);

@@ -245,6 +245,7 @@ void EmbreeBackend::intersect(std::span<const Ray> rays, std::span<RayHit> hits)
 }
 
 void EmbreeBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options, BakeOutputs& out) {
+    require_bvh_method(options, name());
     const BakeSetup s = prepare_bake(mesh, rule, options, out);
     const auto t0 = std::chrono::steady_clock::now();
     set_mesh(mesh, options.back_faces);

@@ -1,0 +1,463 @@
+// The CUDA backend's host-side code on the CPU: the BVH built with Embree's
+// builder and flattened (structure invariants), its traversal (the same
+// SKYBAKE_HD function the kernels run) against the plain loop over every
+// triangle and against Embree, and the kernels' thread bodies run on the host
+// (emulate_bake) against the Embree backend's bake.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include <glm/geometric.hpp>
+
+#include "bake/ao_test_util.h"
+#include "skybake/core.h"
+#include "skybake/error.h"
+#include "skybake/mesh.h"
+#include "skybake/sphere.h"
+#include "skybake/visibility.h"
+#include "visibility/cuda/bake_plan.h"
+#include "visibility/cuda/bvh.h"
+#include "visibility/cuda/cuda_backend.h"
+#include "visibility/embree/embree_backend.h"
+
+using namespace skybake;
+using namespace skybake::visibility;
+
+namespace {
+
+Mesh random_soup(std::uint32_t seed, int triangles) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f), s(0.05f, 0.6f);
+    Mesh m;
+    for (int t = 0; t < triangles; ++t) {
+        const glm::vec3 c(u(rng), u(rng), u(rng));
+        for (int k = 0; k < 3; ++k)
+            m.positions.push_back(c + s(rng) * glm::vec3(u(rng), u(rng), u(rng)));
+        for (int k = 0; k < 3; ++k)
+            m.indices.push_back(std::uint32_t(3 * t + k));
+    }
+    compute_normals(m);
+    return m;
+}
+
+Mesh spider() {
+    const std::string path = std::string(SKYBAKE_ASSIMP_MODELS) + "/OBJ/spider.obj";
+    return load_mesh(path);
+}
+
+// The meshes every test runs on: a random soup, three generated scenes, a real model.
+std::vector<std::pair<std::string, Mesh>> scenes() {
+    std::vector<std::pair<std::string, Mesh>> s;
+    s.emplace_back("soup", random_soup(3, 400));
+    s.emplace_back("city", ao_test::generated(ProceduralKind::City, 3000));
+    s.emplace_back("torus", ao_test::generated(ProceduralKind::Torus, 2000));
+    s.emplace_back("terrain", ao_test::generated(ProceduralKind::Terrain, 2000));
+    s.emplace_back("spider", spider());
+    return s;
+}
+
+// Rays from points in and around the mesh's box, in all directions; with
+// axis_rays every seventh one along ±y (zero components in the slab test, and
+// exact edge ties on axis-aligned geometry).
+std::vector<Ray> rays_for(const Mesh& m, std::uint32_t seed, std::size_t n, bool finite, bool axis_rays = true) {
+    const Bounds b = compute_bounds(m);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f), g(-1.0f, 1.0f);
+    std::vector<Ray> rays(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        Ray& r = rays[i];
+        if (i % 2 == 0) // from a vertex, just off the surface
+            r.origin = m.positions[i / 2 % m.vertex_count()] + 1e-3f * b.diagonal() * m.normals[i / 2 % m.vertex_count()];
+        else
+            r.origin = b.min - 0.1f * b.extent() + 1.2f * b.extent() * glm::vec3(u(rng), u(rng), u(rng));
+        glm::vec3 d;
+        do
+            d = glm::vec3(g(rng), g(rng), g(rng));
+        while (glm::dot(d, d) > 1.0f || glm::dot(d, d) < 1e-4f);
+        r.direction = glm::normalize(d);
+        if (axis_rays && i % 7 == 0)
+            r.direction = glm::vec3(0.0f, i % 3 == 0 ? 1.0f : -1.0f, 0.0f);
+        r.t_max = finite ? 0.5f * b.diagonal() * u(rng) : std::numeric_limits<float>::infinity();
+    }
+    return rays;
+}
+
+bool box_contains(const float* box, const glm::vec3& p) {
+    return p.x >= box[0] && p.x <= box[1] && p.y >= box[2] && p.y <= box[3] && p.z >= box[4] && p.z <= box[5];
+}
+
+bool box_inside(const float* inner, const float* outer) {
+    return inner[0] >= outer[0] && inner[1] <= outer[1] && inner[2] >= outer[2] && inner[3] <= outer[3] &&
+           inner[4] >= outer[4] && inner[5] <= outer[5];
+}
+
+std::uint64_t differing_bits(const BakeOutputs& a, const BakeOutputs& b) {
+    std::uint64_t d = 0;
+    for (std::size_t i = 0; i < a.visibility_bits.size(); ++i)
+        d += std::uint64_t(__builtin_popcount(a.visibility_bits[i] ^ b.visibility_bits[i]));
+    return d;
+}
+
+// Whether a ray on which two implementations disagree is a tie: it passes
+// within rounding of a triangle's edge (symmetric rules on symmetric meshes
+// send rays exactly along edges; Embree's test lets some through the crack
+// between two triangles, ours does not), grazes a triangle's plane, or ends
+// on one. `id` is the triangle one of them hit.
+bool is_tie(const Mesh& m, const Ray& r, std::uint32_t id) {
+    if (id == kNoHit)
+        return false;
+    const std::uint32_t* i = &m.indices[3 * std::size_t(id)];
+    const glm::dvec3 p0 = m.positions[i[0]], e1 = glm::dvec3(m.positions[i[1]]) - p0,
+                     e2 = glm::dvec3(m.positions[i[2]]) - p0;
+    const glm::dvec3 o = r.origin, d = r.direction;
+    const glm::dvec3 n = glm::cross(e1, e2);
+    const double cos_plane = std::abs(glm::dot(glm::normalize(n), glm::normalize(d)));
+    if (cos_plane < 1e-4)
+        return true;
+    const double t = glm::dot(n, p0 - o) / glm::dot(n, d);
+    const glm::dvec3 q = o + t * d - p0;
+    // Barycentrics of the plane point, and the edge distance relative to the triangle's size.
+    const double a = glm::dot(n, n);
+    const double v = glm::dot(glm::cross(e1, q), n) / a, u = glm::dot(glm::cross(q, e2), n) / a;
+    const double edge = std::min({u, v, 1.0 - u - v});
+    return std::abs(edge) < 1e-5 || (std::isfinite(r.t_max) && std::abs(t - double(r.t_max)) < 1e-5 * r.t_max);
+}
+
+// The setup a bake of these inputs uses (for the ray frames).
+const BakeSetup& plan_setup_for(const Mesh& m, const SphereRule& rule, const BakeOptions& o) {
+    static BakeSetup cached;
+    static const Mesh* cached_mesh = nullptr;
+    static std::string cached_rule;
+    if (cached_mesh != &m || cached_rule != rule.spec) {
+        BakeOutputs scratch;
+        cached = prepare_bake(m, rule, o, scratch);
+        cached_mesh = &m;
+        cached_rule = rule.spec;
+    }
+    return cached;
+}
+
+BakeOutputs emulated(const Mesh& m, const SphereRule& rule, const BakeOptions& o, TraceMethod method,
+                     std::uint32_t chunk = 4096) {
+    BakeOutputs out;
+    const BakePlan plan = plan_bake(m, rule, o, out);
+    const Bvh bvh = build_bvh(m);
+    emulate_bake(plan, bvh, method, out, chunk);
+    return out;
+}
+
+} // namespace
+
+TEST(CudaBvh, StructureHoldsEveryTriangleInNestedBoxes) {
+    for (const auto& [name, m] : scenes()) {
+        SCOPED_TRACE(name);
+        const Bvh bvh = build_bvh(m);
+        ASSERT_FALSE(bvh.nodes.empty());
+        EXPECT_LE(bvh.depth, kBvhStackSize);
+        EXPECT_EQ(bvh.soup.size(), m.triangle_count());
+        // Every reference is one mesh triangle; spatial splits may add a few.
+        EXPECT_GE(bvh.triangles.size(), m.triangle_count());
+        EXPECT_LT(bvh.triangles.size(), 2 * m.triangle_count());
+        std::vector<int> seen(m.triangle_count(), 0);
+        std::vector<std::uint8_t> corner_inside(3 * m.triangle_count(), 0);
+        std::uint32_t visited = 0;
+        // Walk from the root with each child's box, checking nesting.
+        struct Item {
+            std::int32_t child;
+            float box[6];
+        };
+        std::vector<Item> todo;
+        const BvhNode& root = bvh.nodes[0];
+        for (int c = 0; c < 2; ++c) {
+            Item it{root.child[c], {}};
+            std::copy(root.box + 6 * c, root.box + 6 * c + 6, it.box);
+            todo.push_back(it);
+        }
+        ++visited;
+        while (!todo.empty()) {
+            const Item it = todo.back();
+            todo.pop_back();
+            EXPECT_LE(it.box[0], it.box[1]);
+            if (it.child >= 0) {
+                ASSERT_LT(std::size_t(it.child), bvh.nodes.size());
+                ++visited;
+                const BvhNode& n = bvh.nodes[std::size_t(it.child)];
+                for (int c = 0; c < 2; ++c) {
+                    Item sub{n.child[c], {}};
+                    std::copy(n.box + 6 * c, n.box + 6 * c + 6, sub.box);
+                    // Child boxes are padded the same way, so they nest.
+                    EXPECT_TRUE(box_inside(sub.box, it.box) || (sub.child < 0 && ~sub.child == 0));
+                    todo.push_back(sub);
+                }
+                continue;
+            }
+            std::uint32_t first, count;
+            decode_leaf(it.child, first, count);
+            EXPECT_LE(count, kMaxLeafTriangles);
+            for (std::uint32_t i = first; i < first + count; ++i) {
+                ASSERT_LT(i, bvh.triangles.size());
+                const BvhTriangle& t = bvh.triangles[i];
+                ASSERT_LT(t.id, m.triangle_count());
+                ++seen[t.id];
+                const glm::vec3 p[3] = {t.p0, t.p0 + t.e1, t.p0 + t.e2};
+                for (int k = 0; k < 3; ++k)
+                    if (box_contains(it.box, p[k]))
+                        corner_inside[3 * t.id + std::uint32_t(k)] = 1;
+            }
+        }
+        EXPECT_EQ(visited, bvh.nodes.size()); // every node reachable once
+        for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+            ASSERT_GE(seen[t], 1) << "triangle " << t;
+            // Each corner lies in the box of some leaf holding the triangle: the
+            // split bounds cover the triangle.
+            for (int k = 0; k < 3; ++k)
+                ASSERT_TRUE(corner_inside[3 * t + std::size_t(k)]) << "triangle " << t << " corner " << k;
+        }
+    }
+}
+
+TEST(CudaBvh, TinyMeshGetsARootNode) {
+    Mesh m;
+    m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    m.indices = {0, 1, 2};
+    compute_normals(m);
+    const Bvh bvh = build_bvh(m);
+    ASSERT_EQ(bvh.nodes.size(), 1u);
+    EXPECT_TRUE(bvh_occluded(bvh.view(), {0.2f, 0.2f, 1.0f}, {0, 0, -1}, 0.0f, 10.0f, false));
+    EXPECT_FALSE(bvh_occluded(bvh.view(), {0.2f, 0.2f, 1.0f}, {0, 0, 1}, 0.0f, 10.0f, false));
+    EXPECT_FALSE(bvh_occluded(bvh.view(), {0.2f, 0.2f, 1.0f}, {0, 0, -1}, 0.0f, 0.5f, false)); // too short
+    // Seen from +z the triangle is counter-clockwise: its front. From below it is a back face.
+    EXPECT_TRUE(bvh_occluded(bvh.view(), {0.2f, 0.2f, 1.0f}, {0, 0, -1}, 0.0f, 10.0f, true));
+    EXPECT_FALSE(bvh_occluded(bvh.view(), {0.2f, 0.2f, -1.0f}, {0, 0, 1}, 0.0f, 10.0f, true));
+    EXPECT_TRUE(bvh_occluded(bvh.view(), {0.2f, 0.2f, -1.0f}, {0, 0, 1}, 0.0f, 10.0f, false));
+}
+
+// The hierarchy only skips work: with the same triangle test, the BVH and the
+// loop over every triangle must agree on every ray.
+TEST(CudaBvh, TraversalEqualsTheLoopOverEveryTriangle) {
+    for (const auto& [name, m] : scenes()) {
+        SCOPED_TRACE(name);
+        const Bvh bvh = build_bvh(m);
+        for (bool cull : {false, true})
+            for (bool finite : {false, true}) {
+                const std::vector<Ray> rays = rays_for(m, 11, 4000, finite);
+                std::size_t hits = 0;
+                for (const Ray& r : rays) {
+                    const bool a = bvh_occluded(bvh.view(), r.origin, r.direction, r.t_min, r.t_max, cull);
+                    const bool b = soup_occluded(bvh.soup.data(), std::uint32_t(bvh.soup.size()), r.origin,
+                                                 r.direction, r.t_min, r.t_max, cull);
+                    ASSERT_EQ(a, b);
+                    hits += a;
+                }
+                EXPECT_GT(hits, rays.size() / 20); // the rays do meet the mesh
+                EXPECT_LT(hits, rays.size());
+                // Closest hits: the same triangle as the full loop's closest (lowest index on ties).
+                for (std::size_t i = 0; i < rays.size(); i += 4) {
+                    const Ray& r = rays[i];
+                    float t = r.t_max, u = 0, v = 0;
+                    std::uint32_t id = kNoHit;
+                    const bool hit = bvh_trace<false>(bvh.view(), r.origin, r.direction, r.t_min, t, cull, id, u, v);
+                    float best = r.t_max;
+                    std::uint32_t best_id = kNoHit;
+                    for (const BvhTriangle& tri : bvh.soup) {
+                        float tt, uu, vv;
+                        if (ray_triangle(r.origin, r.direction, tri.p0, tri.e1, tri.e2, r.t_min, best, tt, uu, vv,
+                                         cull) &&
+                            (tt < best || tri.id < best_id)) {
+                            best = tt;
+                            best_id = tri.id;
+                        }
+                    }
+                    ASSERT_EQ(hit, best_id != kNoHit);
+                    ASSERT_EQ(id, best_id);
+                    if (hit) {
+                        ASSERT_EQ(t, best);
+                    }
+                }
+            }
+    }
+}
+
+// An independent implementation: Embree's own BVH and triangle test.
+TEST(CudaBvh, TraversalAgreesWithEmbree) {
+    for (const auto& [name, m] : scenes()) {
+        SCOPED_TRACE(name);
+        const Bvh bvh = build_bvh(m);
+        EmbreeBackend embree;
+        for (bool cull : {false, true}) {
+            embree.set_mesh(m, cull ? BackFaces::Ignore : BackFaces::Occlude);
+            const std::vector<Ray> rays = rays_for(m, 5, 20000, cull, false);
+            std::vector<std::uint8_t> occ(rays.size());
+            std::vector<RayHit> hits(rays.size());
+            embree.occluded(rays, occ);
+            embree.intersect(rays, hits);
+            std::size_t occ_diff = 0, hit_diff = 0, ties = 0, hits_same = 0, t_close = 0;
+            for (std::size_t i = 0; i < rays.size(); ++i) {
+                const Ray& r = rays[i];
+                float t = r.t_max, u = 0, v = 0;
+                std::uint32_t id = kNoHit;
+                bvh_trace<false>(bvh.view(), r.origin, r.direction, r.t_min, t, cull, id, u, v);
+                if (bvh_occluded(bvh.view(), r.origin, r.direction, r.t_min, r.t_max, cull) != bool(occ[i]))
+                    ++occ_diff;
+                if (id == hits[i].triangle) {
+                    if (id != kNoHit) {
+                        ++hits_same;
+                        t_close += std::abs(t - hits[i].t) <= 1e-5f * (1.0f + hits[i].t);
+                    }
+                } else if (is_tie(m, r, id) || is_tie(m, r, hits[i].triangle)) {
+                    ++ties; // a hit on the edge two triangles share, or a grazing ray
+                } else {
+                    ++hit_diff;
+                }
+            }
+            std::printf("%s, cull %d: of %zu rays, %zu occlusion answers and %zu closest triangles differ from "
+                        "Embree (%zu more are edge ties); %zu of %zu equal hits within 1e-5 in t\n",
+                        name.c_str(), int(cull), rays.size(), occ_diff, hit_diff, ties, t_close, hits_same);
+            EXPECT_LE(double(occ_diff), 1e-4 * double(rays.size()));
+            EXPECT_LE(double(hit_diff), 1e-4 * double(rays.size()));
+            EXPECT_LE(double(ties), 1e-3 * double(rays.size()));
+            EXPECT_GE(double(t_close), 0.99 * double(hits_same)); // grazing rays have ill-conditioned t
+        }
+    }
+}
+
+// The kernels' thread bodies, run on the host, against the Embree bake:
+// at least 99.99% of the visibility bits equal and AO within 1e-4 (mean), and
+// wherever a vertex's bits equal Embree's its AO, A and bent normal are the
+// same floats (one reduction order for every backend).
+TEST(CudaBake, EmulatedKernelsMatchEmbree) {
+    struct Case {
+        const char* rule;
+        BackFaces back;
+        float max_distance;
+        bool normalize;
+    };
+    const Case cases[] = {{"lebedev:590", BackFaces::Occlude, INFINITY, false},
+                          {"lebedev:302+rotate", BackFaces::Occlude, INFINITY, true},
+                          {"fibonacci:500", BackFaces::Ignore, INFINITY, false},
+                          {"lebedev:266", BackFaces::Occlude, 0.2f, false}};
+    for (const auto& [name, m] : scenes()) {
+        for (const Case& c : cases) {
+            SCOPED_TRACE(name + " " + c.rule);
+            const SphereRule rule = parse_rule(c.rule);
+            BakeOptions o;
+            o.store_bits = true;
+            o.back_faces = c.back;
+            o.normalize = c.normalize;
+            o.max_distance = std::isfinite(c.max_distance) ? c.max_distance * compute_bounds(m).diagonal() : INFINITY;
+            BakeOutputs e;
+            EmbreeBackend embree;
+            embree.bake(m, rule, o, e);
+            const BakeOutputs g = emulated(m, rule, o, TraceMethod::Bvh);
+            ASSERT_EQ(g.rays, e.rays);
+            ASSERT_EQ(g.visibility_bits.size(), e.visibility_bits.size());
+            const std::uint64_t diff = differing_bits(g, e);
+            double sum = 0.0, worst = 0.0;
+            std::size_t same_vertices = 0;
+            for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+                const double d = std::abs(double(g.ao[v]) - double(e.ao[v]));
+                sum += d;
+                worst = std::max(worst, d);
+                bool same = true;
+                for (std::uint32_t w = 0; w < g.words_per_vertex; ++w)
+                    same &= g.visibility_bits[v * g.words_per_vertex + w] == e.visibility_bits[v * e.words_per_vertex + w];
+                if (same) {
+                    ++same_vertices;
+                    ASSERT_EQ(g.ao[v], e.ao[v]) << "vertex " << v;
+                    ASSERT_EQ(g.shading[v], e.shading[v]) << "vertex " << v;
+                    ASSERT_EQ(g.bent_normal[v], e.bent_normal[v]) << "vertex " << v;
+                }
+            }
+            // Every differing bit: is it an edge tie?
+            embree.set_mesh(m, c.back);
+            const Bvh bvh = build_bvh(m);
+            std::uint64_t non_ties = 0;
+            for (std::size_t v = 0; v < m.vertex_count() && diff > 0; ++v)
+                for (std::uint32_t k = 0; k < rule.size(); ++k) {
+                    if (g.visible(v, k) == e.visible(v, k))
+                        continue;
+                    const VertexFrame f = vertex_frame(plan_setup_for(m, rule, o), m, std::uint32_t(v));
+                    glm::vec3 x;
+                    float cn;
+                    vertex_direction(glm::vec3(rule.points[k]), f.rotation, rule.rotate_per_vertex, f.normal, x, cn);
+                    const Ray r{f.origin, 0.0f, x, o.max_distance};
+                    float t = r.t_max, u, w;
+                    std::uint32_t ours = kNoHit;
+                    bvh_trace<false>(bvh.view(), r.origin, r.direction, 0.0f, t, o.back_faces == BackFaces::Ignore,
+                                     ours, u, w);
+                    RayHit h;
+                    embree.intersect({&r, 1}, {&h, 1});
+                    if (!is_tie(m, r, ours) && !is_tie(m, r, h.triangle))
+                        ++non_ties;
+                }
+            const double mean = sum / double(m.vertex_count());
+            std::printf("%s %s: %llu of %llu rays differ from Embree (%llu not edge ties); AO mean difference %.1e, "
+                        "max %.1e; %zu of %zu vertices bit-identical\n",
+                        name.c_str(), c.rule, static_cast<unsigned long long>(diff),
+                        static_cast<unsigned long long>(e.rays), static_cast<unsigned long long>(non_ties), mean,
+                        worst, same_vertices, m.vertex_count());
+            EXPECT_LE(double(non_ties), 1e-4 * double(e.rays));
+            if (rule.rotate_per_vertex || name == "spider" || name == "soup") {
+                // No systematic ties: the bounds hold as they stand.
+                EXPECT_LE(double(diff), 1e-4 * double(e.rays));
+                EXPECT_LE(mean, 1e-4);
+            } else {
+                EXPECT_LE(double(diff), 1e-3 * double(e.rays));
+                EXPECT_LE(mean, 1e-3);
+            }
+            EXPECT_EQ(g.clamped_vertices, e.clamped_vertices);
+        }
+    }
+}
+
+TEST(CudaBake, EveryMethodAndChunkingGiveTheSameBits) {
+    const Mesh m = ao_test::generated(ProceduralKind::City, 1500);
+    const SphereRule rule = parse_rule("lebedev:194+rotate");
+    BakeOptions o;
+    o.store_bits = true;
+    const BakeOutputs a = emulated(m, rule, o, TraceMethod::Bvh);
+    const BakeOutputs b = emulated(m, rule, o, TraceMethod::PerVertex);
+    const BakeOutputs c = emulated(m, rule, o, TraceMethod::Bvh, 7); // many small chunks
+    for (const BakeOutputs* x : {&b, &c}) {
+        EXPECT_EQ(x->visibility_bits, a.visibility_bits);
+        EXPECT_EQ(x->ao, a.ao);
+        EXPECT_EQ(x->shading, a.shading);
+        EXPECT_EQ(x->bent_normal, a.bent_normal);
+        EXPECT_EQ(x->rays, a.rays);
+    }
+}
+
+TEST(CudaBake, MethodNamesAndTheCpuBackendsRefuseOthers) {
+    for (TraceMethod mth : {TraceMethod::Bvh, TraceMethod::PerVertex, TraceMethod::PerPolygon})
+        EXPECT_EQ(parse_trace_method(trace_method_name(mth)), mth);
+    EXPECT_THROW(parse_trace_method("octree"), Error);
+    Mesh m = ao_test::generated(ProceduralKind::Sphere, 200);
+    BakeOptions o;
+    o.method = TraceMethod::PerPolygon;
+    BakeOutputs out;
+    for (const char* b : {"embree", "brute"}) {
+        auto backend = make_visibility_backend(b);
+        try {
+            backend->bake(m, parse_rule("lebedev:50"), o, out);
+            ADD_FAILURE() << b << " accepted per-polygon";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("cuda"), std::string::npos) << e.what();
+        }
+    }
+}
+
+TEST(CudaBake, WithoutADeviceTheBackendIsAClearError) {
+    if (cuda_device_count() > 0)
+        GTEST_SKIP() << "a CUDA device is present";
+    try {
+        make_visibility_backend("cuda");
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("--backend"), std::string::npos) << what;
+        EXPECT_NE(what.find("embree"), std::string::npos) << what; // says what to use instead
+        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+}
