@@ -11,6 +11,7 @@
 
 #include "cli_runner.h"
 #include "skybake/bake.h"
+#include "skybake/core.h"
 #include "skybake/mesh.h"
 
 using skybake::test::run_cli;
@@ -125,7 +126,10 @@ TEST(AoCli, BadInputIsOneLineAndNoOutput) {
     expect_one_line_error(run_cli({"ao", dir + "/missing.obj", "-o", out}), 1, "missing.obj");
     expect_one_line_error(run_cli({"ao", in, "-o", out, "--rule", "lebedev:500"}), 1, "lebedev");
     expect_one_line_error(run_cli({"ao", in, "-o", out, "--rule", "phong:a=4,n=3"}), 1, "Phong");
-    expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "cuda"}), 1, "no CUDA visibility backend");
+    if (skybake::cuda_device_count() == 0) // no GPU, or a build without CUDA
+        expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "cuda"}), 1, "--backend cuda");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--method", "per-vertex"}), 1, "--backend cuda");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "cuda", "--method", "octree"}), 1, "--method");
     expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "optix"}), 1, "--backend");
     expect_one_line_error(run_cli({"ao", in, "-o", dir + "/out.obj"}), 1, "--output");
     expect_one_line_error(run_cli({"ao", in, "-o", out, "--preview", dir + "/p.jpg"}), 1, "--preview");

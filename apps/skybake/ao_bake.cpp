@@ -1,4 +1,4 @@
-// skybake ao INPUT -o OUTPUT.glb|.ply [--rule R] [--backend B] [--max-distance D] [--offset E]
+// skybake ao INPUT -o OUTPUT.glb|.ply [--rule R] [--backend B] [--method M] [--max-distance D] [--offset E]
 //            [--back-faces occlude|ignore] [--normalize] [--bits FILE] [--preview FILE.png]
 //            [--preview-size WxH] [--json]
 #include <algorithm>
@@ -10,6 +10,7 @@
 #include "cli.h"
 #include "commands.h"
 #include "skybake/bake.h"
+#include "skybake/core.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 #include "skybake/visibility.h"
@@ -24,6 +25,7 @@ struct AoOptions {
     std::string input, output;
     std::string rule = kDefaultRule;
     std::string backend = "embree";
+    std::string method = "bvh";
     double max_distance = std::numeric_limits<double>::infinity();
     double offset = -1.0;
     std::string back_faces = "occlude";
@@ -39,6 +41,11 @@ std::string lower_extension(const std::string& path) {
     std::string e = std::filesystem::path(path).extension().string();
     std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
     return e;
+}
+
+// The GPU a backend runs on ("" for the CPU backends).
+std::string device_name(const VisibilityBackend& backend) {
+    return std::string(backend.name()) == "cuda" ? cuda_device_name() : std::string();
 }
 
 nlohmann::json stats(const std::vector<float>& v) {
@@ -58,6 +65,10 @@ void run(const AoOptions& o) {
     // Everything that can be checked without the mesh is checked first, so a
     // typo fails at once and no output file is started.
     const SphereRule rule = parse_rule(o.rule);
+    const TraceMethod method = parse_trace_method(o.method);
+    if (method != TraceMethod::Bvh && o.backend != "cuda")
+        throw Error(fmt::format("--method {} is a method of the cuda backend; add --backend cuda", o.method),
+                    "--method");
     const auto backend = make_visibility_backend(o.backend);
     const std::string out_ext = lower_extension(o.output);
     if (out_ext != ".glb" && out_ext != ".ply")
@@ -85,6 +96,7 @@ void run(const AoOptions& o) {
     b.back_faces = parse_back_faces(o.back_faces);
     b.normalize = o.normalize;
     b.store_bits = !o.bits.empty();
+    b.method = method;
 
     Mesh mesh = load_mesh(o.input);
     BakeOutputs outputs;
@@ -104,6 +116,8 @@ void run(const AoOptions& o) {
         nlohmann::json j = {{"input", o.input},
                             {"output", o.output},
                             {"backend", r.backend},
+                            {"method", r.method},
+                            {"device", device_name(*backend)},
                             {"rule", r.rule},
                             {"directions", r.directions},
                             {"vertices", r.vertices},
@@ -131,10 +145,12 @@ void run(const AoOptions& o) {
     for (float a : outputs.ao)
         mean += a;
     mean /= double(std::max<std::size_t>(1, outputs.ao.size()));
-    info("baked {} vertices ({} triangles) with {} ({} directions, {}): {} rays in {:.2f} s ({:.1f} Mrays/s), "
+    const std::string device = device_name(*backend);
+    info("baked {} vertices ({} triangles) with {} ({} directions, {}{}{}): {} rays in {:.2f} s ({:.1f} Mrays/s), "
          "BVH {:.2f} s",
-         r.vertices, r.triangles, r.rule, r.directions, r.backend, r.rays, r.seconds, r.rays_per_second() * 1e-6,
-         r.build_seconds);
+         r.vertices, r.triangles, r.rule, r.directions, r.backend,
+         method == TraceMethod::Bvh ? "" : " " + r.method, device.empty() ? "" : " on " + device, r.rays, r.seconds,
+         r.rays_per_second() * 1e-6, r.build_seconds);
     if (r.negative_weights)
         info("note: {} has negative weights; {} vertices had sums outside [0, 1], clamped", r.rule,
              r.clamped_vertices);
@@ -154,7 +170,12 @@ void add_ao_bake(CLI::App& group) {
                     "Sphere rule, e.g. lebedev:5810, design:t21, fibonacci:1000, mc:4096; add +rotate for a random "
                     "rotation per vertex (see 'sphere list')")
         ->capture_default_str();
-    sub->add_option("--backend", o->backend, "Visibility backend: embree, or brute (test oracle, small meshes)")
+    sub->add_option("--backend", o->backend,
+                    "Visibility backend: embree (CPU), cuda (NVIDIA GPU), or brute (test oracle, small meshes)")
+        ->capture_default_str();
+    sub->add_option("--method", o->method,
+                    "How the cuda backend finds blockers: bvh, per-vertex (every triangle for every ray, the seed's "
+                    "naive method) or per-polygon (every triangle, cached in shared memory)")
         ->capture_default_str();
     sub->add_option("--max-distance", o->max_distance,
                     "Ignore occluders further than this, in mesh units (default: unlimited)");

@@ -42,7 +42,8 @@ namespace skybake {
 // [SECTION] Bake a mesh ------------------------------------------------------------------
 
 struct AoBakeReport {
-    std::string backend;           // "embree", ...
+    std::string backend;           // "embree", "cuda", "brute"
+    std::string method;            // "bvh", "per-vertex", "per-polygon" (BakeOptions::method)
     std::string rule;              // canonical rule spec
     std::size_t vertices = 0;
     std::size_t triangles = 0;

@@ -42,6 +42,7 @@ AoBakeReport bake_ambient_occlusion(Mesh& mesh, const SphereRule& rule, Visibili
 
     AoBakeReport r;
     r.backend = backend.name();
+    r.method = trace_method_name(options.method);
     r.rule = rule.spec;
     r.vertices = n;
     r.triangles = mesh.triangle_count();

@@ -11,7 +11,6 @@
 
 #include <glm/geometric.hpp>
 
-#include "bake/ao_test_util.h"
 #include "skybake/core.h"
 #include "skybake/error.h"
 #include "skybake/mesh.h"
@@ -20,6 +19,7 @@
 #include "visibility/cuda/bake_plan.h"
 #include "visibility/cuda/bvh.h"
 #include "visibility/cuda/cuda_backend.h"
+#include "visibility/cuda/test_scenes.h"
 #include "visibility/embree/embree_backend.h"
 
 using namespace skybake;
@@ -27,62 +27,7 @@ using namespace skybake::visibility;
 
 namespace {
 
-Mesh random_soup(std::uint32_t seed, int triangles) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(-1.0f, 1.0f), s(0.05f, 0.6f);
-    Mesh m;
-    for (int t = 0; t < triangles; ++t) {
-        const glm::vec3 c(u(rng), u(rng), u(rng));
-        for (int k = 0; k < 3; ++k)
-            m.positions.push_back(c + s(rng) * glm::vec3(u(rng), u(rng), u(rng)));
-        for (int k = 0; k < 3; ++k)
-            m.indices.push_back(std::uint32_t(3 * t + k));
-    }
-    compute_normals(m);
-    return m;
-}
-
-Mesh spider() {
-    const std::string path = std::string(SKYBAKE_ASSIMP_MODELS) + "/OBJ/spider.obj";
-    return load_mesh(path);
-}
-
-// The meshes every test runs on: a random soup, three generated scenes, a real model.
-std::vector<std::pair<std::string, Mesh>> scenes() {
-    std::vector<std::pair<std::string, Mesh>> s;
-    s.emplace_back("soup", random_soup(3, 400));
-    s.emplace_back("city", ao_test::generated(ProceduralKind::City, 3000));
-    s.emplace_back("torus", ao_test::generated(ProceduralKind::Torus, 2000));
-    s.emplace_back("terrain", ao_test::generated(ProceduralKind::Terrain, 2000));
-    s.emplace_back("spider", spider());
-    return s;
-}
-
-// Rays from points in and around the mesh's box, in all directions; with
-// axis_rays every seventh one along ±y (zero components in the slab test, and
-// exact edge ties on axis-aligned geometry).
-std::vector<Ray> rays_for(const Mesh& m, std::uint32_t seed, std::size_t n, bool finite, bool axis_rays = true) {
-    const Bounds b = compute_bounds(m);
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(0.0f, 1.0f), g(-1.0f, 1.0f);
-    std::vector<Ray> rays(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        Ray& r = rays[i];
-        if (i % 2 == 0) // from a vertex, just off the surface
-            r.origin = m.positions[i / 2 % m.vertex_count()] + 1e-3f * b.diagonal() * m.normals[i / 2 % m.vertex_count()];
-        else
-            r.origin = b.min - 0.1f * b.extent() + 1.2f * b.extent() * glm::vec3(u(rng), u(rng), u(rng));
-        glm::vec3 d;
-        do
-            d = glm::vec3(g(rng), g(rng), g(rng));
-        while (glm::dot(d, d) > 1.0f || glm::dot(d, d) < 1e-4f);
-        r.direction = glm::normalize(d);
-        if (axis_rays && i % 7 == 0)
-            r.direction = glm::vec3(0.0f, i % 3 == 0 ? 1.0f : -1.0f, 0.0f);
-        r.t_max = finite ? 0.5f * b.diagonal() * u(rng) : std::numeric_limits<float>::infinity();
-    }
-    return rays;
-}
+using namespace skybake::visibility_test;
 
 bool box_contains(const float* box, const glm::vec3& p) {
     return p.x >= box[0] && p.x <= box[1] && p.y >= box[2] && p.y <= box[3] && p.z >= box[4] && p.z <= box[5];
@@ -91,52 +36,6 @@ bool box_contains(const float* box, const glm::vec3& p) {
 bool box_inside(const float* inner, const float* outer) {
     return inner[0] >= outer[0] && inner[1] <= outer[1] && inner[2] >= outer[2] && inner[3] <= outer[3] &&
            inner[4] >= outer[4] && inner[5] <= outer[5];
-}
-
-std::uint64_t differing_bits(const BakeOutputs& a, const BakeOutputs& b) {
-    std::uint64_t d = 0;
-    for (std::size_t i = 0; i < a.visibility_bits.size(); ++i)
-        d += std::uint64_t(__builtin_popcount(a.visibility_bits[i] ^ b.visibility_bits[i]));
-    return d;
-}
-
-// Whether a ray on which two implementations disagree is a tie: it passes
-// within rounding of a triangle's edge (symmetric rules on symmetric meshes
-// send rays exactly along edges; Embree's test lets some through the crack
-// between two triangles, ours does not), grazes a triangle's plane, or ends
-// on one. `id` is the triangle one of them hit.
-bool is_tie(const Mesh& m, const Ray& r, std::uint32_t id) {
-    if (id == kNoHit)
-        return false;
-    const std::uint32_t* i = &m.indices[3 * std::size_t(id)];
-    const glm::dvec3 p0 = m.positions[i[0]], e1 = glm::dvec3(m.positions[i[1]]) - p0,
-                     e2 = glm::dvec3(m.positions[i[2]]) - p0;
-    const glm::dvec3 o = r.origin, d = r.direction;
-    const glm::dvec3 n = glm::cross(e1, e2);
-    const double cos_plane = std::abs(glm::dot(glm::normalize(n), glm::normalize(d)));
-    if (cos_plane < 1e-4)
-        return true;
-    const double t = glm::dot(n, p0 - o) / glm::dot(n, d);
-    const glm::dvec3 q = o + t * d - p0;
-    // Barycentrics of the plane point, and the edge distance relative to the triangle's size.
-    const double a = glm::dot(n, n);
-    const double v = glm::dot(glm::cross(e1, q), n) / a, u = glm::dot(glm::cross(q, e2), n) / a;
-    const double edge = std::min({u, v, 1.0 - u - v});
-    return std::abs(edge) < 1e-5 || (std::isfinite(r.t_max) && std::abs(t - double(r.t_max)) < 1e-5 * r.t_max);
-}
-
-// The setup a bake of these inputs uses (for the ray frames).
-const BakeSetup& plan_setup_for(const Mesh& m, const SphereRule& rule, const BakeOptions& o) {
-    static BakeSetup cached;
-    static const Mesh* cached_mesh = nullptr;
-    static std::string cached_rule;
-    if (cached_mesh != &m || cached_rule != rule.spec) {
-        BakeOutputs scratch;
-        cached = prepare_bake(m, rule, o, scratch);
-        cached_mesh = &m;
-        cached_rule = rule.spec;
-    }
-    return cached;
 }
 
 BakeOutputs emulated(const Mesh& m, const SphereRule& rule, const BakeOptions& o, TraceMethod method,
@@ -323,10 +222,8 @@ TEST(CudaBvh, TraversalAgreesWithEmbree) {
     }
 }
 
-// The kernels' thread bodies, run on the host, against the Embree bake:
-// at least 99.99% of the visibility bits equal and AO within 1e-4 (mean), and
-// wherever a vertex's bits equal Embree's its AO, A and bent normal are the
-// same floats (one reduction order for every backend).
+// The kernels' thread bodies, run on the host, against the Embree bake
+// (expect_agreement: bits, AO, and the same floats wherever the bits agree).
 TEST(CudaBake, EmulatedKernelsMatchEmbree) {
     struct Case {
         const char* rule;
@@ -351,63 +248,9 @@ TEST(CudaBake, EmulatedKernelsMatchEmbree) {
             EmbreeBackend embree;
             embree.bake(m, rule, o, e);
             const BakeOutputs g = emulated(m, rule, o, TraceMethod::Bvh);
-            ASSERT_EQ(g.rays, e.rays);
-            ASSERT_EQ(g.visibility_bits.size(), e.visibility_bits.size());
-            const std::uint64_t diff = differing_bits(g, e);
-            double sum = 0.0, worst = 0.0;
-            std::size_t same_vertices = 0;
-            for (std::size_t v = 0; v < m.vertex_count(); ++v) {
-                const double d = std::abs(double(g.ao[v]) - double(e.ao[v]));
-                sum += d;
-                worst = std::max(worst, d);
-                bool same = true;
-                for (std::uint32_t w = 0; w < g.words_per_vertex; ++w)
-                    same &= g.visibility_bits[v * g.words_per_vertex + w] == e.visibility_bits[v * e.words_per_vertex + w];
-                if (same) {
-                    ++same_vertices;
-                    ASSERT_EQ(g.ao[v], e.ao[v]) << "vertex " << v;
-                    ASSERT_EQ(g.shading[v], e.shading[v]) << "vertex " << v;
-                    ASSERT_EQ(g.bent_normal[v], e.bent_normal[v]) << "vertex " << v;
-                }
-            }
-            // Every differing bit: is it an edge tie?
-            embree.set_mesh(m, c.back);
-            const Bvh bvh = build_bvh(m);
-            std::uint64_t non_ties = 0;
-            for (std::size_t v = 0; v < m.vertex_count() && diff > 0; ++v)
-                for (std::uint32_t k = 0; k < rule.size(); ++k) {
-                    if (g.visible(v, k) == e.visible(v, k))
-                        continue;
-                    const VertexFrame f = vertex_frame(plan_setup_for(m, rule, o), m, std::uint32_t(v));
-                    glm::vec3 x;
-                    float cn;
-                    vertex_direction(glm::vec3(rule.points[k]), f.rotation, rule.rotate_per_vertex, f.normal, x, cn);
-                    const Ray r{f.origin, 0.0f, x, o.max_distance};
-                    float t = r.t_max, u, w;
-                    std::uint32_t ours = kNoHit;
-                    bvh_trace<false>(bvh.view(), r.origin, r.direction, 0.0f, t, o.back_faces == BackFaces::Ignore,
-                                     ours, u, w);
-                    RayHit h;
-                    embree.intersect({&r, 1}, {&h, 1});
-                    if (!is_tie(m, r, ours) && !is_tie(m, r, h.triangle))
-                        ++non_ties;
-                }
-            const double mean = sum / double(m.vertex_count());
-            std::printf("%s %s: %llu of %llu rays differ from Embree (%llu not edge ties); AO mean difference %.1e, "
-                        "max %.1e; %zu of %zu vertices bit-identical\n",
-                        name.c_str(), c.rule, static_cast<unsigned long long>(diff),
-                        static_cast<unsigned long long>(e.rays), static_cast<unsigned long long>(non_ties), mean,
-                        worst, same_vertices, m.vertex_count());
-            EXPECT_LE(double(non_ties), 1e-4 * double(e.rays));
-            if (rule.rotate_per_vertex || name == "spider" || name == "soup") {
-                // No systematic ties: the bounds hold as they stand.
-                EXPECT_LE(double(diff), 1e-4 * double(e.rays));
-                EXPECT_LE(mean, 1e-4);
-            } else {
-                EXPECT_LE(double(diff), 1e-3 * double(e.rays));
-                EXPECT_LE(mean, 1e-3);
-            }
-            EXPECT_EQ(g.clamped_vertices, e.clamped_vertices);
+            const Agreement a = compare_bakes(m, rule, o, g, e);
+            a.print((name + " " + c.rule + ", host emulation").c_str());
+            expect_agreement(a, tie_free(name, rule));
         }
     }
 }

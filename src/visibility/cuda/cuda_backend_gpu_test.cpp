@@ -1,0 +1,185 @@
+// The CUDA backend on a GPU (every test skips without a CUDA device):
+//  - every method against the Embree backend: at least 99.99% of the bits
+//    equal and AO within 1e-4 (expect_agreement in test_scenes.h);
+//  - against its own host emulation (the same thread bodies on the CPU): the
+//    same bits, and AO equal to the float (the kernels are built without
+//    contracted multiply-adds);
+//  - ray queries, chunking, determinism, memory limits, a mesh of 1M triangles.
+#include <gtest/gtest.h>
+
+#include "skybake/core.h"
+
+#if defined(SKYBAKE_HAS_CUDA)
+#include <cstdio>
+
+#include "skybake/error.h"
+#include "visibility/cuda/bake_plan.h"
+#include "visibility/cuda/cuda_backend.h"
+#include "visibility/cuda/test_scenes.h"
+
+using namespace skybake;
+using namespace skybake::visibility;
+using namespace skybake::visibility_test;
+
+namespace {
+
+#define SKIP_WITHOUT_GPU()                                                                                             \
+    if (cuda_device_count() == 0)                                                                                      \
+    GTEST_SKIP() << "no CUDA device"
+
+BakeOutputs gpu_bake(CudaBackend& cuda, const Mesh& m, const SphereRule& rule, const BakeOptions& o) {
+    BakeOutputs out;
+    cuda.bake(m, rule, o, out);
+    return out;
+}
+
+BakeOutputs host_emulation(const Mesh& m, const SphereRule& rule, const BakeOptions& o, TraceMethod method) {
+    BakeOutputs out;
+    const BakePlan plan = plan_bake(m, rule, o, out);
+    emulate_bake(plan, build_bvh(m), method, out);
+    return out;
+}
+
+void expect_same(const BakeOutputs& a, const BakeOutputs& b) {
+    EXPECT_EQ(a.visibility_bits, b.visibility_bits);
+    EXPECT_EQ(a.ao, b.ao);
+    EXPECT_EQ(a.shading, b.shading);
+    EXPECT_EQ(a.bent_normal, b.bent_normal);
+    EXPECT_EQ(a.rays, b.rays);
+    EXPECT_EQ(a.clamped_vertices, b.clamped_vertices);
+}
+
+} // namespace
+
+TEST(CudaBackendGpu, EveryMethodMatchesEmbreeAndTheHostEmulation) {
+    SKIP_WITHOUT_GPU();
+    CudaBackend cuda;
+    std::printf("device: %s\n", cuda.device_name().c_str());
+    const char* rules[] = {"lebedev:590", "lebedev:302+rotate", "lebedev:5810"};
+    for (const auto& [name, m] : scenes())
+        for (const char* spec : rules)
+            for (BackFaces back : {BackFaces::Occlude, BackFaces::Ignore}) {
+                const SphereRule rule = parse_rule(spec);
+                BakeOptions o;
+                o.store_bits = true;
+                o.back_faces = back;
+                BakeOutputs e;
+                make_visibility_backend("embree")->bake(m, rule, o, e);
+                const BakeOutputs host = host_emulation(m, rule, o, TraceMethod::Bvh);
+                for (TraceMethod method : {TraceMethod::Bvh, TraceMethod::PerVertex, TraceMethod::PerPolygon}) {
+                    const std::string label = name + " " + spec + " " + back_faces_name(back) + " " +
+                                              trace_method_name(method);
+                    SCOPED_TRACE(label);
+                    o.method = method;
+                    const BakeOutputs g = gpu_bake(cuda, m, rule, o);
+                    const Agreement a = compare_bakes(m, rule, o, g, e);
+                    a.print(label.c_str());
+                    expect_agreement(a, tie_free(name, rule));
+                    expect_same(g, host);
+                }
+            }
+}
+
+TEST(CudaBackendGpu, RayQueriesEqualTheHostTraversal) {
+    SKIP_WITHOUT_GPU();
+    CudaBackend cuda;
+    for (const auto& [name, m] : scenes())
+        for (bool cull : {false, true}) {
+            SCOPED_TRACE(name);
+            cuda.set_mesh(m, cull ? BackFaces::Ignore : BackFaces::Occlude);
+            const std::vector<Ray> rays = rays_for(m, 17, 50000, cull);
+            std::vector<std::uint8_t> occ(rays.size());
+            std::vector<RayHit> hits(rays.size());
+            cuda.occluded(rays, occ);
+            cuda.intersect(rays, hits);
+            const BvhView bvh = cuda.bvh().view();
+            for (std::size_t i = 0; i < rays.size(); ++i) {
+                const Ray& r = rays[i];
+                ASSERT_EQ(bool(occ[i]), bvh_occluded(bvh, r.origin, r.direction, r.t_min, r.t_max, cull)) << i;
+                float t = r.t_max, u = 0, v = 0;
+                std::uint32_t id = kNoHit;
+                bvh_trace<false>(bvh, r.origin, r.direction, r.t_min, t, cull, id, u, v);
+                ASSERT_EQ(hits[i].triangle, id) << i;
+                if (id != kNoHit) {
+                    ASSERT_EQ(hits[i].t, t) << i;
+                    ASSERT_EQ(hits[i].u, u) << i;
+                    ASSERT_EQ(hits[i].v, v) << i;
+                }
+            }
+        }
+}
+
+TEST(CudaBackendGpu, ChunkedLaunchesAndRepeatedRunsGiveTheSameResult) {
+    SKIP_WITHOUT_GPU();
+    const Mesh m = ao_test::generated(ProceduralKind::City, 20000);
+    const SphereRule rule = parse_rule("lebedev:1202+rotate");
+    BakeOptions o;
+    o.store_bits = true;
+    CudaBackend cuda;
+    const BakeOutputs one = gpu_bake(cuda, m, rule, o);
+    EXPECT_EQ(cuda.last_chunk_count(), 1u);
+    EXPECT_EQ(gpu_bake(cuda, m, rule, o).visibility_bits, one.visibility_bits);
+    CudaBackend::Limits small;
+    small.slots_per_launch = 32ull * 38 * 101; // 101 vertices of 38 words per chunk
+    cuda.set_limits(small);
+    const BakeOutputs chunked = gpu_bake(cuda, m, rule, o);
+    EXPECT_EQ(cuda.last_chunk_count(), (std::uint32_t(m.vertex_count()) + 100) / 101);
+    expect_same(chunked, one);
+    for (TraceMethod method : {TraceMethod::PerVertex, TraceMethod::PerPolygon}) {
+        small.tests_per_launch = 32ull * 38 * 7 * m.triangle_count(); // 7 vertices per chunk
+        cuda.set_limits(small);
+        o.method = method;
+        const BakeOutputs b = gpu_bake(cuda, m, rule, o);
+        EXPECT_GT(cuda.last_chunk_count(), 100u);
+        expect_same(b, one);
+    }
+}
+
+TEST(CudaBackendGpu, TooLittleMemoryIsAClearErrorOrSmallerChunks) {
+    SKIP_WITHOUT_GPU();
+    const Mesh m = ao_test::generated(ProceduralKind::Terrain, 50000);
+    const SphereRule rule = parse_rule("lebedev:590");
+    CudaBackend cuda;
+    CudaBackend::Limits tiny;
+    tiny.memory_bytes = 64 << 10; // 64 KiB: not even the BVH
+    cuda.set_limits(tiny);
+    try {
+        BakeOutputs out;
+        cuda.bake(m, rule, {}, out);
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("GPU memory"), std::string::npos) << e.what();
+    }
+    // Room for the BVH and about a hundred vertices: many chunks, same answer.
+    const std::size_t bvh_bytes = build_bvh(m).bytes();
+    CudaBackend::Limits some;
+    some.memory_bytes = bvh_bytes + 590 * 20 + 2 * 100 * 200;
+    cuda.set_limits(some);
+    BakeOutputs a, b;
+    cuda.bake(m, rule, {}, a);
+    EXPECT_GT(cuda.last_chunk_count(), m.vertex_count() / 200);
+    cuda.set_limits({});
+    cuda.bake(m, rule, {}, b);
+    EXPECT_EQ(a.ao, b.ao);
+}
+
+TEST(CudaBackendGpu, MillionTriangleCityMatchesEmbree) {
+    SKIP_WITHOUT_GPU();
+    const Mesh m = ao_test::generated(ProceduralKind::City, 1'000'000);
+    const SphereRule rule = parse_rule("lebedev:110+rotate");
+    BakeOptions o;
+    o.store_bits = true;
+    BakeOutputs e, g;
+    make_visibility_backend("embree")->bake(m, rule, o, e);
+    CudaBackend cuda;
+    cuda.bake(m, rule, o, g);
+    std::printf("1M city: %.3f s on the GPU (BVH %.2f s), %.3f s with Embree\n", g.trace_seconds, g.build_seconds,
+                e.trace_seconds);
+    const Agreement a = compare_bakes(m, rule, o, g, e);
+    a.print("1M city");
+    expect_agreement(a, true);
+}
+
+#else
+TEST(CudaBackendGpu, NotInThisBuild) { GTEST_SKIP() << "this build has no CUDA"; }
+#endif
