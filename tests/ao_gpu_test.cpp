@@ -1,9 +1,8 @@
 // skybake ao --backend cuda, end to end: every method against the Embree
 // backend on a generated mesh and a real one (skipped without a CUDA device).
-#include <gtest/gtest.h>
-
 #include <filesystem>
 
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"

@@ -52,8 +52,8 @@ struct GpuBakeParams {
     bool store_bits = false;
     // One chunk of vertices.
     std::uint32_t vertex_count = 0;
-    const glm::vec3* origins = nullptr;  // ray origins, vertex_count
-    const glm::vec3* normals = nullptr;  // unit, vertex_count
+    const glm::vec3* origins = nullptr;   // ray origins, vertex_count
+    const glm::vec3* normals = nullptr;   // unit, vertex_count
     const glm::mat3* rotations = nullptr; // vertex_count when rotate, else unused
     std::uint32_t* visit_words = nullptr; // vertex_count × words, bit j = visiting position j
     // Outputs, vertex_count each (rule_words: vertex_count × words, zeroed first).

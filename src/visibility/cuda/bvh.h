@@ -1,5 +1,5 @@
 // The CUDA backend's bounding volume hierarchy: built on the CPU with Embree's
-// BVH builder (rtcBuildBVH, SAH with spatial splits), flattened into a compact
+// BVH builder (rtcBuildBVH, binned SAH, spatial splits optional), flattened into a compact
 // binary layout that one GPU thread walks with a small stack, and traversed by
 // SKYBAKE_HD functions, so that the same code runs in the kernels and in the
 // CPU unit tests.
@@ -8,7 +8,8 @@
 // High-Performance Graphics 2009 (node layout: both child boxes in one 64-byte
 // node, read as four 16-byte loads).
 // Stich M., Friedrich H., Dietrich A. Spatial splits in bounding volume
-// hierarchies. High-Performance Graphics 2009 (Embree's high-quality builder).
+// hierarchies. High-Performance Graphics 2009 (Embree's high-quality builder,
+// optional).
 // Ize T. Robust BVH ray traversal. JCGT 2(2), 2013 (the slab test below never
 // culls a box that the exact ray meets).
 //
@@ -60,9 +61,9 @@ struct alignas(16) BvhTriangle {
 static_assert(sizeof(BvhTriangle) == 48);
 
 inline constexpr int kLeafCountBits = 4;
-inline constexpr std::uint32_t kMaxLeafTriangles = 8;             // < 2^kLeafCountBits
-inline constexpr std::uint32_t kMaxBvhTriangleRefs = 1u << 27;    // leaf references (first < 2^27)
-inline constexpr int kBvhStackSize = 64;                          // deepest tree the traversal walks
+inline constexpr std::uint32_t kMaxLeafTriangles = 8;          // < 2^kLeafCountBits
+inline constexpr std::uint32_t kMaxBvhTriangleRefs = 1u << 27; // leaf references (first < 2^27)
+inline constexpr int kBvhStackSize = 64;                       // deepest tree the traversal walks
 
 SKYBAKE_HD_INLINE std::int32_t encode_leaf(std::uint32_t first, std::uint32_t count) {
     return ~std::int32_t((first << kLeafCountBits) | count);
@@ -99,32 +100,43 @@ struct Bvh {
 };
 
 // Builds the BVH of mesh.positions / mesh.indices (the mesh must pass
-// validate_mesh). Boxes are widened by a few millionths of the mesh's size so
-// that rounding in the triangle test cannot make the BVH miss a hit that the
-// plain loop over all triangles finds. Throws skybake::Error when the mesh is
-// too large (more than kMaxBvhTriangleRefs references) or Embree fails.
-Bvh build_bvh(const Mesh& mesh);
+// validate_mesh) with Embree's binned SAH builder; spatial_splits adds
+// Stich et al.'s split references (Embree's high quality). On the generated
+// scenes, splits cost 4 to 14 times the build time and did not speed up the
+// traversal (docs/PERFORMANCE.md), so they are off by default. Boxes are widened by a few millionths of the mesh's size
+// so that rounding in the triangle test cannot make the BVH miss a hit that the plain loop over all triangles finds.
+// Throws skybake::Error when the mesh is too large (more than kMaxBvhTriangleRefs references) or Embree fails.
+Bvh build_bvh(const Mesh& mesh, bool spatial_splits = false);
 
 // [SECTION] Traversal (host and device) -------------------------------------------------------
 
 namespace bvh_detail {
 
-SKYBAKE_HD_INLINE float min3(float a, float b, float c) { return fminf(a, fminf(b, c)); }
-SKYBAKE_HD_INLINE float max3(float a, float b, float c) { return fmaxf(a, fmaxf(b, c)); }
+// Plain comparisons: the slab distances below are never NaN, and these are
+// single min/max instructions on both the CPU and the GPU.
+SKYBAKE_HD_INLINE float min2(float a, float b) {
+    return a < b ? a : b;
+}
+SKYBAKE_HD_INLINE float max2(float a, float b) {
+    return a > b ? a : b;
+}
 
 // 1 + 2γ(3), γ(n) = nε/(1 − nε), ε = 2^-24: Ize's bound on the rounding of the slab distances.
 inline constexpr float kSlabScale = 1.0f + 2.0f * (3.0f * 5.9604645e-8f) / (1.0f - 3.0f * 5.9604645e-8f);
 
 // Slab test of box (lo.x hi.x lo.y hi.y lo.z hi.z at b[0..5]) against the ray
-// o + t/inv_d for t in [t_min, t_max]. fminf/fmaxf drop the NaN of 0 · ∞ (a ray
-// parallel to a slab and starting on its plane), which only widens the test.
+// o + t/inv_d for t in [t_min, t_max] (t_min ≥ 0). inv_d is finite
+// (inverse_direction), so no distance is 0 · ∞ = NaN: a ray parallel to a slab
+// gets 0 for a plane through its origin and a huge distance otherwise, which
+// keeps the slab when the origin is inside it and at worst keeps a box it
+// could have culled.
 SKYBAKE_HD_INLINE bool slab(const float* b, const glm::vec3& o, const glm::vec3& inv_d, float t_min, float t_max,
                             float& t_near) {
     const float x0 = (b[0] - o.x) * inv_d.x, x1 = (b[1] - o.x) * inv_d.x;
     const float y0 = (b[2] - o.y) * inv_d.y, y1 = (b[3] - o.y) * inv_d.y;
     const float z0 = (b[4] - o.z) * inv_d.z, z1 = (b[5] - o.z) * inv_d.z;
-    t_near = fmaxf(max3(fminf(x0, x1), fminf(y0, y1), fminf(z0, z1)), t_min);
-    const float t_far = fminf(min3(fmaxf(x0, x1), fmaxf(y0, y1), fmaxf(z0, z1)), t_max);
+    t_near = max2(max2(min2(x0, x1), min2(y0, y1)), max2(min2(z0, z1), t_min));
+    const float t_far = min2(min2(max2(x0, x1), max2(y0, y1)), min2(max2(z0, z1), t_max));
     return t_near <= t_far * kSlabScale;
 }
 
@@ -160,8 +172,15 @@ SKYBAKE_HD_INLINE BvhTriangle load_triangle(const BvhTriangle* triangles, std::u
 
 } // namespace bvh_detail
 
-// Reciprocal direction for the slab test (±∞ for a zero component).
-SKYBAKE_HD_INLINE glm::vec3 inverse_direction(const glm::vec3& d) { return glm::vec3(1.0f / d.x, 1.0f / d.y, 1.0f / d.z); }
+// Reciprocal direction for the slab test: ±1e30 instead of ±∞ for a zero (or
+// denormal) component, so that the slab distances are never NaN.
+SKYBAKE_HD_INLINE float inverse_component(float d) {
+    // The sign of a zero does not matter: the slab test orders both distances.
+    return (d > 1e-30f || d < -1e-30f) ? 1.0f / d : (d < 0.0f ? -1e30f : 1e30f);
+}
+SKYBAKE_HD_INLINE glm::vec3 inverse_direction(const glm::vec3& d) {
+    return glm::vec3(inverse_component(d.x), inverse_component(d.y), inverse_component(d.z));
+}
 
 // Closest or any hit of the ray o + t·d, t in (t_min, t_max], with the
 // Möller–Trumbore test of triangle_hd.h. cull_back: triangles met from behind
@@ -170,8 +189,8 @@ SKYBAKE_HD_INLINE glm::vec3 inverse_direction(const glm::vec3& d) { return glm::
 // returns the closest, ties broken by the lower mesh triangle index so that the
 // answer does not depend on the tree: t_max, hit_id, u, v are then updated.
 template <bool AnyHit>
-SKYBAKE_HD_INLINE bool bvh_trace(const BvhView& bvh, const glm::vec3& o, const glm::vec3& d, float t_min,
-                                 float& t_max, bool cull_back, std::uint32_t& hit_id, float& hit_u, float& hit_v) {
+SKYBAKE_HD_INLINE bool bvh_trace(const BvhView& bvh, const glm::vec3& o, const glm::vec3& d, float t_min, float& t_max,
+                                 bool cull_back, std::uint32_t& hit_id, float& hit_u, float& hit_v) {
     using namespace bvh_detail;
     const glm::vec3 inv_d = inverse_direction(d);
     std::int32_t stack[kBvhStackSize];

@@ -1,6 +1,6 @@
 // Builds the CUDA backend's BVH on the CPU with Embree's BVH builder
-// (rtcBuildBVH, binned SAH with spatial splits) and flattens it into the
-// layout of cuda/bvh.h.
+// (rtcBuildBVH: binned SAH, optionally with spatial splits) and flattens it
+// into the layout of cuda/bvh.h.
 //
 // Stich M., Friedrich H., Dietrich A. Spatial splits in bounding volume
 // hierarchies. High-Performance Graphics 2009.
@@ -186,7 +186,7 @@ void on_error(void* user, RTCError code, const char* message) {
 
 } // namespace
 
-Bvh build_bvh(const Mesh& mesh) {
+Bvh build_bvh(const Mesh& mesh, bool spatial_splits) {
     validate_mesh(mesh, "mesh");
     const auto t0 = std::chrono::steady_clock::now();
     const std::size_t nt = mesh.triangle_count();
@@ -202,7 +202,7 @@ Bvh build_bvh(const Mesh& mesh) {
         out.soup[t] = make_triangle(mesh, std::uint32_t(t));
 
     // Room for the references spatial splits add.
-    std::vector<RTCBuildPrimitive> prims(2 * nt);
+    std::vector<RTCBuildPrimitive> prims(spatial_splits ? 2 * nt : nt);
     glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-std::numeric_limits<float>::infinity());
     for (std::size_t t = 0; t < nt; ++t) {
         const std::uint32_t* i = &mesh.indices[3 * t];
@@ -229,7 +229,8 @@ Bvh build_bvh(const Mesh& mesh) {
     ctx.mesh = &mesh;
     RTCBuildArguments args = rtcDefaultBuildArguments();
     args.byteSize = sizeof(args);
-    args.buildQuality = RTC_BUILD_QUALITY_HIGH; // SAH with spatial splits
+    // MEDIUM: binned SAH. HIGH adds spatial splits, which need splitPrimitive.
+    args.buildQuality = spatial_splits ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM;
     args.buildFlags = RTC_BUILD_FLAG_NONE;
     args.maxBranchingFactor = 2;
     args.maxDepth = kBvhStackSize;
@@ -246,7 +247,7 @@ Bvh build_bvh(const Mesh& mesh) {
     args.setNodeChildren = set_children;
     args.setNodeBounds = set_bounds;
     args.createLeaf = create_leaf;
-    args.splitPrimitive = split_primitive;
+    args.splitPrimitive = spatial_splits ? split_primitive : nullptr;
     args.userPtr = &ctx;
     const auto* root = static_cast<const BuildNode*>(rtcBuildBVH(&args));
     if (!root || rtcGetDeviceError(h.device) != RTC_ERROR_NONE) {

@@ -3,13 +3,12 @@
 // SKYBAKE_HD function the kernels run) against the plain loop over every
 // triangle and against Embree, and the kernels' thread bodies run on the host
 // (emulate_bake) against the Embree backend's bake.
-#include <gtest/gtest.h>
-
 #include <cmath>
 #include <cstdio>
 #include <random>
 
 #include <glm/geometric.hpp>
+#include <gtest/gtest.h>
 
 #include "skybake/core.h"
 #include "skybake/error.h"
@@ -50,71 +49,72 @@ BakeOutputs emulated(const Mesh& m, const SphereRule& rule, const BakeOptions& o
 } // namespace
 
 TEST(CudaBvh, StructureHoldsEveryTriangleInNestedBoxes) {
-    for (const auto& [name, m] : scenes()) {
-        SCOPED_TRACE(name);
-        const Bvh bvh = build_bvh(m);
-        ASSERT_FALSE(bvh.nodes.empty());
-        EXPECT_LE(bvh.depth, kBvhStackSize);
-        EXPECT_EQ(bvh.soup.size(), m.triangle_count());
-        // Every reference is one mesh triangle; spatial splits may add a few.
-        EXPECT_GE(bvh.triangles.size(), m.triangle_count());
-        EXPECT_LT(bvh.triangles.size(), 2 * m.triangle_count());
-        std::vector<int> seen(m.triangle_count(), 0);
-        std::vector<std::uint8_t> corner_inside(3 * m.triangle_count(), 0);
-        std::uint32_t visited = 0;
-        // Walk from the root with each child's box, checking nesting.
-        struct Item {
-            std::int32_t child;
-            float box[6];
-        };
-        std::vector<Item> todo;
-        const BvhNode& root = bvh.nodes[0];
-        for (int c = 0; c < 2; ++c) {
-            Item it{root.child[c], {}};
-            std::copy(root.box + 6 * c, root.box + 6 * c + 6, it.box);
-            todo.push_back(it);
-        }
-        ++visited;
-        while (!todo.empty()) {
-            const Item it = todo.back();
-            todo.pop_back();
-            EXPECT_LE(it.box[0], it.box[1]);
-            if (it.child >= 0) {
-                ASSERT_LT(std::size_t(it.child), bvh.nodes.size());
-                ++visited;
-                const BvhNode& n = bvh.nodes[std::size_t(it.child)];
-                for (int c = 0; c < 2; ++c) {
-                    Item sub{n.child[c], {}};
-                    std::copy(n.box + 6 * c, n.box + 6 * c + 6, sub.box);
-                    // Child boxes are padded the same way, so they nest.
-                    EXPECT_TRUE(box_inside(sub.box, it.box) || (sub.child < 0 && ~sub.child == 0));
-                    todo.push_back(sub);
+    for (const auto& [name, m] : scenes())
+        for (bool splits : {false, true}) {
+            SCOPED_TRACE(name + (splits ? " with spatial splits" : ""));
+            const Bvh bvh = build_bvh(m, splits);
+            ASSERT_FALSE(bvh.nodes.empty());
+            EXPECT_LE(bvh.depth, kBvhStackSize);
+            EXPECT_EQ(bvh.soup.size(), m.triangle_count());
+            // Every reference is one mesh triangle; spatial splits may add a few.
+            EXPECT_GE(bvh.triangles.size(), m.triangle_count());
+            EXPECT_LT(bvh.triangles.size(), 2 * m.triangle_count());
+            std::vector<int> seen(m.triangle_count(), 0);
+            std::vector<std::uint8_t> corner_inside(3 * m.triangle_count(), 0);
+            std::uint32_t visited = 0;
+            // Walk from the root with each child's box, checking nesting.
+            struct Item {
+                std::int32_t child;
+                float box[6];
+            };
+            std::vector<Item> todo;
+            const BvhNode& root = bvh.nodes[0];
+            for (int c = 0; c < 2; ++c) {
+                Item it{root.child[c], {}};
+                std::copy(root.box + 6 * c, root.box + 6 * c + 6, it.box);
+                todo.push_back(it);
+            }
+            ++visited;
+            while (!todo.empty()) {
+                const Item it = todo.back();
+                todo.pop_back();
+                EXPECT_LE(it.box[0], it.box[1]);
+                if (it.child >= 0) {
+                    ASSERT_LT(std::size_t(it.child), bvh.nodes.size());
+                    ++visited;
+                    const BvhNode& n = bvh.nodes[std::size_t(it.child)];
+                    for (int c = 0; c < 2; ++c) {
+                        Item sub{n.child[c], {}};
+                        std::copy(n.box + 6 * c, n.box + 6 * c + 6, sub.box);
+                        // Child boxes are padded the same way, so they nest.
+                        EXPECT_TRUE(box_inside(sub.box, it.box) || (sub.child < 0 && ~sub.child == 0));
+                        todo.push_back(sub);
+                    }
+                    continue;
                 }
-                continue;
+                std::uint32_t first, count;
+                decode_leaf(it.child, first, count);
+                EXPECT_LE(count, kMaxLeafTriangles);
+                for (std::uint32_t i = first; i < first + count; ++i) {
+                    ASSERT_LT(i, bvh.triangles.size());
+                    const BvhTriangle& t = bvh.triangles[i];
+                    ASSERT_LT(t.id, m.triangle_count());
+                    ++seen[t.id];
+                    const glm::vec3 p[3] = {t.p0, t.p0 + t.e1, t.p0 + t.e2};
+                    for (int k = 0; k < 3; ++k)
+                        if (box_contains(it.box, p[k]))
+                            corner_inside[3 * t.id + std::uint32_t(k)] = 1;
+                }
             }
-            std::uint32_t first, count;
-            decode_leaf(it.child, first, count);
-            EXPECT_LE(count, kMaxLeafTriangles);
-            for (std::uint32_t i = first; i < first + count; ++i) {
-                ASSERT_LT(i, bvh.triangles.size());
-                const BvhTriangle& t = bvh.triangles[i];
-                ASSERT_LT(t.id, m.triangle_count());
-                ++seen[t.id];
-                const glm::vec3 p[3] = {t.p0, t.p0 + t.e1, t.p0 + t.e2};
+            EXPECT_EQ(visited, bvh.nodes.size()); // every node reachable once
+            for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+                ASSERT_GE(seen[t], 1) << "triangle " << t;
+                // Each corner lies in the box of some leaf holding the triangle: the
+                // split bounds cover the triangle.
                 for (int k = 0; k < 3; ++k)
-                    if (box_contains(it.box, p[k]))
-                        corner_inside[3 * t.id + std::uint32_t(k)] = 1;
+                    ASSERT_TRUE(corner_inside[3 * t + std::size_t(k)]) << "triangle " << t << " corner " << k;
             }
         }
-        EXPECT_EQ(visited, bvh.nodes.size()); // every node reachable once
-        for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-            ASSERT_GE(seen[t], 1) << "triangle " << t;
-            // Each corner lies in the box of some leaf holding the triangle: the
-            // split bounds cover the triangle.
-            for (int k = 0; k < 3; ++k)
-                ASSERT_TRUE(corner_inside[3 * t + std::size_t(k)]) << "triangle " << t << " corner " << k;
-        }
-    }
 }
 
 TEST(CudaBvh, TinyMeshGetsARootNode) {
@@ -136,47 +136,49 @@ TEST(CudaBvh, TinyMeshGetsARootNode) {
 // The hierarchy only skips work: with the same triangle test, the BVH and the
 // loop over every triangle must agree on every ray.
 TEST(CudaBvh, TraversalEqualsTheLoopOverEveryTriangle) {
-    for (const auto& [name, m] : scenes()) {
-        SCOPED_TRACE(name);
-        const Bvh bvh = build_bvh(m);
-        for (bool cull : {false, true})
-            for (bool finite : {false, true}) {
-                const std::vector<Ray> rays = rays_for(m, 11, 4000, finite);
-                std::size_t hits = 0;
-                for (const Ray& r : rays) {
-                    const bool a = bvh_occluded(bvh.view(), r.origin, r.direction, r.t_min, r.t_max, cull);
-                    const bool b = soup_occluded(bvh.soup.data(), std::uint32_t(bvh.soup.size()), r.origin,
-                                                 r.direction, r.t_min, r.t_max, cull);
-                    ASSERT_EQ(a, b);
-                    hits += a;
-                }
-                EXPECT_GT(hits, rays.size() / 20); // the rays do meet the mesh
-                EXPECT_LT(hits, rays.size());
-                // Closest hits: the same triangle as the full loop's closest (lowest index on ties).
-                for (std::size_t i = 0; i < rays.size(); i += 4) {
-                    const Ray& r = rays[i];
-                    float t = r.t_max, u = 0, v = 0;
-                    std::uint32_t id = kNoHit;
-                    const bool hit = bvh_trace<false>(bvh.view(), r.origin, r.direction, r.t_min, t, cull, id, u, v);
-                    float best = r.t_max;
-                    std::uint32_t best_id = kNoHit;
-                    for (const BvhTriangle& tri : bvh.soup) {
-                        float tt, uu, vv;
-                        if (ray_triangle(r.origin, r.direction, tri.p0, tri.e1, tri.e2, r.t_min, best, tt, uu, vv,
-                                         cull) &&
-                            (tt < best || tri.id < best_id)) {
-                            best = tt;
-                            best_id = tri.id;
+    for (const auto& [name, m] : scenes())
+        for (bool splits : {false, true}) {
+            SCOPED_TRACE(name + (splits ? " with spatial splits" : ""));
+            const Bvh bvh = build_bvh(m, splits);
+            for (bool cull : {false, true})
+                for (bool finite : {false, true}) {
+                    const std::vector<Ray> rays = rays_for(m, 11, 4000, finite);
+                    std::size_t hits = 0;
+                    for (const Ray& r : rays) {
+                        const bool a = bvh_occluded(bvh.view(), r.origin, r.direction, r.t_min, r.t_max, cull);
+                        const bool b = soup_occluded(bvh.soup.data(), std::uint32_t(bvh.soup.size()), r.origin,
+                                                     r.direction, r.t_min, r.t_max, cull);
+                        ASSERT_EQ(a, b);
+                        hits += a;
+                    }
+                    EXPECT_GT(hits, rays.size() / 20); // the rays do meet the mesh
+                    EXPECT_LT(hits, rays.size());
+                    // Closest hits: the same triangle as the full loop's closest (lowest index on ties).
+                    for (std::size_t i = 0; i < rays.size(); i += 4) {
+                        const Ray& r = rays[i];
+                        float t = r.t_max, u = 0, v = 0;
+                        std::uint32_t id = kNoHit;
+                        const bool hit =
+                            bvh_trace<false>(bvh.view(), r.origin, r.direction, r.t_min, t, cull, id, u, v);
+                        float best = r.t_max;
+                        std::uint32_t best_id = kNoHit;
+                        for (const BvhTriangle& tri : bvh.soup) {
+                            float tt, uu, vv;
+                            if (ray_triangle(r.origin, r.direction, tri.p0, tri.e1, tri.e2, r.t_min, best, tt, uu, vv,
+                                             cull) &&
+                                (tt < best || tri.id < best_id)) {
+                                best = tt;
+                                best_id = tri.id;
+                            }
+                        }
+                        ASSERT_EQ(hit, best_id != kNoHit);
+                        ASSERT_EQ(id, best_id);
+                        if (hit) {
+                            ASSERT_EQ(t, best);
                         }
                     }
-                    ASSERT_EQ(hit, best_id != kNoHit);
-                    ASSERT_EQ(id, best_id);
-                    if (hit) {
-                        ASSERT_EQ(t, best);
-                    }
                 }
-            }
-    }
+        }
 }
 
 // An independent implementation: Embree's own BVH and triangle test.

@@ -29,7 +29,7 @@ namespace skybake::visibility {
 
 namespace {
 
-constexpr unsigned kBlock = 128; // threads per block: 4 warps
+constexpr unsigned kBlock = 128;   // threads per block: 4 warps
 constexpr unsigned kTile = kBlock; // triangles per shared-memory tile (one per thread)
 constexpr std::size_t kRaysPerQuery = std::size_t(1) << 22;
 
@@ -217,7 +217,9 @@ void to_device(cuda::DeviceBuffer<T>& dst, const T* src, std::size_t n, cudaStre
         SKYBAKE_CUDA_CHECK(cudaMemcpyAsync(dst.data(), src, n * sizeof(T), cudaMemcpyHostToDevice, stream));
 }
 
-std::string mib(std::uint64_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB"; }
+std::string mib(std::uint64_t bytes) {
+    return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB";
+}
 
 } // namespace
 
@@ -236,7 +238,8 @@ struct CudaBackend::Impl {
     std::uint64_t budget() const {
         std::size_t free_bytes = 0, total = 0;
         SKYBAKE_CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total));
-        const std::uint64_t held = nodes.size() * sizeof(BvhNode) + (triangles.size() + soup.size()) * sizeof(BvhTriangle);
+        const std::uint64_t held =
+            nodes.size() * sizeof(BvhNode) + (triangles.size() + soup.size()) * sizeof(BvhTriangle);
         if (limits.memory_bytes > 0)
             return limits.memory_bytes > held ? limits.memory_bytes - held : 0;
         return std::uint64_t(double(free_bytes) * 0.9);
@@ -256,11 +259,21 @@ CudaBackend::CudaBackend() : impl_(std::make_unique<Impl>()) {
 
 CudaBackend::~CudaBackend() = default;
 
-void CudaBackend::set_limits(const Limits& limits) { impl_->limits = limits; }
-const CudaBackend::Limits& CudaBackend::limits() const { return impl_->limits; }
-std::string CudaBackend::device_name() const { return impl_->device; }
-std::uint32_t CudaBackend::last_chunk_count() const { return impl_->chunks; }
-const Bvh& CudaBackend::bvh() const { return impl_->bvh; }
+void CudaBackend::set_limits(const Limits& limits) {
+    impl_->limits = limits;
+}
+const CudaBackend::Limits& CudaBackend::limits() const {
+    return impl_->limits;
+}
+std::string CudaBackend::device_name() const {
+    return impl_->device;
+}
+std::uint32_t CudaBackend::last_chunk_count() const {
+    return impl_->chunks;
+}
+const Bvh& CudaBackend::bvh() const {
+    return impl_->bvh;
+}
 
 void CudaBackend::set_mesh(const Mesh& mesh, BackFaces back_faces) {
     Impl& m = *impl_;
@@ -312,8 +325,7 @@ void CudaBackend::intersect(std::span<const Ray> rays, std::span<RayHit> hits) c
         intersect_kernel<<<cuda::grid_for(n, kBlock), kBlock>>>(m.device_view(), d_rays.data(), d_hits.data(), n,
                                                                 m.cull_back);
         SKYBAKE_CUDA_CHECK(cudaGetLastError());
-        SKYBAKE_CUDA_CHECK(
-            cudaMemcpy(hits.data() + first, d_hits.data(), n * sizeof(RayHit), cudaMemcpyDeviceToHost));
+        SKYBAKE_CUDA_CHECK(cudaMemcpy(hits.data() + first, d_hits.data(), n * sizeof(RayHit), cudaMemcpyDeviceToHost));
     }
 }
 
@@ -437,6 +449,8 @@ void CudaBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
     out.trace_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
 }
 
-std::unique_ptr<VisibilityBackend> make_cuda_backend() { return std::make_unique<CudaBackend>(); }
+std::unique_ptr<VisibilityBackend> make_cuda_backend() {
+    return std::make_unique<CudaBackend>();
+}
 
 } // namespace skybake::visibility

@@ -67,8 +67,8 @@ TEST(CudaBackendGpu, EveryMethodMatchesEmbreeAndTheHostEmulation) {
                 make_visibility_backend("embree")->bake(m, rule, o, e);
                 const BakeOutputs host = host_emulation(m, rule, o, TraceMethod::Bvh);
                 for (TraceMethod method : {TraceMethod::Bvh, TraceMethod::PerVertex, TraceMethod::PerPolygon}) {
-                    const std::string label = name + " " + spec + " " + back_faces_name(back) + " " +
-                                              trace_method_name(method);
+                    const std::string label =
+                        name + " " + spec + " " + back_faces_name(back) + " " + trace_method_name(method);
                     SCOPED_TRACE(label);
                     o.method = method;
                     const BakeOutputs g = gpu_bake(cuda, m, rule, o);
@@ -181,5 +181,7 @@ TEST(CudaBackendGpu, MillionTriangleCityMatchesEmbree) {
 }
 
 #else
-TEST(CudaBackendGpu, NotInThisBuild) { GTEST_SKIP() << "this build has no CUDA"; }
+TEST(CudaBackendGpu, NotInThisBuild) {
+    GTEST_SKIP() << "this build has no CUDA";
+}
 #endif

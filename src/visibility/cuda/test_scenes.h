@@ -4,12 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <cstdio>
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
@@ -68,7 +67,8 @@ inline std::vector<Ray> rays_for(const Mesh& m, std::uint32_t seed, std::size_t 
     for (std::size_t i = 0; i < n; ++i) {
         Ray& r = rays[i];
         if (i % 2 == 0) // from a vertex, just off the surface
-            r.origin = m.positions[i / 2 % m.vertex_count()] + 1e-3f * b.diagonal() * m.normals[i / 2 % m.vertex_count()];
+            r.origin =
+                m.positions[i / 2 % m.vertex_count()] + 1e-3f * b.diagonal() * m.normals[i / 2 % m.vertex_count()];
         else
             r.origin = b.min - 0.1f * b.extent() + 1.2f * b.extent() * glm::vec3(u(rng), u(rng), u(rng));
         glm::vec3 d;
@@ -117,12 +117,12 @@ inline bool is_tie(const Mesh& m, const Ray& r, std::uint32_t id) {
 
 // How a bake compares with a reference bake of the same inputs.
 struct Agreement {
-    std::uint64_t rays = 0;     // reference rays
-    std::uint64_t diff = 0;     // differing visibility bits
-    std::uint64_t non_ties = 0; // ... of which not an edge tie (is_tie)
-    double mean_ao = 0.0, max_ao = 0.0; // |AO − AO_ref| over vertices
+    std::uint64_t rays = 0;                      // reference rays
+    std::uint64_t diff = 0;                      // differing visibility bits
+    std::uint64_t non_ties = 0;                  // ... of which not an edge tie (is_tie)
+    double mean_ao = 0.0, max_ao = 0.0;          // |AO − AO_ref| over vertices
     std::size_t vertices = 0, same_vertices = 0; // vertices whose bits all agree
-    std::size_t value_mismatches = 0; // ... whose AO, A or bent normal still differ
+    std::size_t value_mismatches = 0;            // ... whose AO, A or bent normal still differ
     std::uint64_t rays_diff = 0, clamped_diff = 0;
 
     void print(const char* label) const {

@@ -1,0 +1,221 @@
+// CUDA visibility backend benchmarks.
+//
+// BM_GpuAo: whole bakes (rays, bits and reduction; the BVH build is reported
+//   apart) with the cuda backend and one method, and with the Embree backend
+//   on the same scene in the same iteration (the baseline). Counters: Mrays/s
+//   of each and their ratio. Skipped without a CUDA device.
+// BM_BvhBuild: building the CUDA backend's BVH (Embree's builder with spatial
+//   splits, then flattening) against committing an Embree scene of the same
+//   mesh. Runs anywhere.
+// BM_HostTraversal: the SKYBAKE_HD traversal the kernels run, on one CPU
+//   thread, against rtcOccluded1 on the same rays, also on one thread: a
+//   measure of the BVH's quality that needs no GPU. Runs anywhere.
+#include <chrono>
+#include <map>
+#include <memory>
+
+#include <benchmark/benchmark.h>
+#include <embree3/rtcore.h>
+#include <fmt/format.h>
+
+#include "skybake/core.h"
+#include "skybake/mesh.h"
+#include "skybake/sphere.h"
+#include "skybake/visibility.h"
+#include "visibility/bake_common.h"
+#include "visibility/cuda/bvh.h"
+#include "visibility/cuda/cuda_backend.h"
+#include "visibility/embree/embree_backend.h"
+
+using namespace skybake;
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+ProceduralKind kind_of(int k) {
+    return k == 0 ? ProceduralKind::City : k == 1 ? ProceduralKind::Torus : ProceduralKind::Terrain;
+}
+
+const Mesh& mesh(int kind, std::uint64_t triangles) {
+    static std::map<std::pair<int, std::uint64_t>, std::unique_ptr<Mesh>> cache;
+    auto& slot = cache[{kind, triangles}];
+    if (!slot) {
+        ProceduralOptions p;
+        p.kind = kind_of(kind);
+        p.target_triangles = triangles;
+        slot = std::make_unique<Mesh>(generate_mesh(p));
+    }
+    return *slot;
+}
+
+// Args: kind (0 city, 1 torus, 2 terrain), triangles, Lebedev points, method (0 bvh, 1 per-vertex, 2 per-polygon).
+void BM_GpuAo(benchmark::State& state) {
+    if (cuda_device_count() == 0) {
+        state.SkipWithError("no CUDA device");
+        return;
+    }
+    const Mesh& m = mesh(int(state.range(0)), std::uint64_t(state.range(1)));
+    const SphereRule rule = parse_rule(fmt::format("lebedev:{}", state.range(2)));
+    BakeOptions o;
+    o.method = TraceMethod(state.range(3));
+    auto gpu = make_visibility_backend("cuda");
+    visibility::EmbreeBackend embree;
+    double t_gpu = 0, t_cpu = 0, build = 0;
+    std::uint64_t rays = 0;
+    {
+        BakeOutputs warm; // first launch: context creation, module load
+        gpu->bake(m, rule, o, warm);
+    }
+    for (auto _ : state) {
+        BakeOutputs g, e;
+        gpu->bake(m, rule, o, g);
+        BakeOptions eo = o;
+        eo.method = TraceMethod::Bvh;
+        embree.bake(m, rule, eo, e);
+        if (g.rays != e.rays) {
+            state.SkipWithError("the cuda and embree bakes traced different rays");
+            return;
+        }
+        t_gpu += g.trace_seconds;
+        t_cpu += e.trace_seconds;
+        build += g.build_seconds;
+        rays = g.rays;
+        state.SetIterationTime(g.trace_seconds);
+    }
+    const double it = double(state.iterations());
+    state.SetLabel(cuda_device_name());
+    state.counters["vertices"] = double(m.vertex_count());
+    state.counters["triangles"] = double(m.triangle_count());
+    state.counters["rays"] = double(rays);
+    state.counters["gpu_Mrays"] = double(rays) * it / t_gpu * 1e-6;
+    state.counters["embree_Mrays"] = double(rays) * it / t_cpu * 1e-6;
+    state.counters["speedup"] = t_cpu / t_gpu;
+    state.counters["bvh_build_s"] = build / it;
+}
+
+// Args: kind, triangles, spatial splits (0 or 1).
+void BM_BvhBuild(benchmark::State& state) {
+    const Mesh& m = mesh(int(state.range(0)), std::uint64_t(state.range(1)));
+    const bool splits = state.range(2) != 0;
+    double ours = 0, theirs = 0;
+    std::size_t nodes = 0, refs = 0;
+    int depth = 0;
+    for (auto _ : state) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const visibility::Bvh bvh = visibility::build_bvh(m, splits);
+        const double a = seconds_since(t0);
+        visibility::EmbreeBackend e;
+        const auto t1 = std::chrono::steady_clock::now();
+        e.set_mesh(m, BackFaces::Occlude);
+        theirs += seconds_since(t1);
+        ours += a;
+        nodes = bvh.nodes.size();
+        refs = bvh.triangles.size();
+        depth = bvh.depth;
+        state.SetIterationTime(a);
+    }
+    const double it = double(state.iterations());
+    state.counters["triangles"] = double(m.triangle_count());
+    state.counters["nodes"] = double(nodes);
+    state.counters["refs_per_triangle"] = double(refs) / double(m.triangle_count());
+    state.counters["depth"] = double(depth);
+    state.counters["build_s"] = ours / it;
+    state.counters["embree_scene_s"] = theirs / it;
+    state.counters["ratio"] = theirs / ours; // > 1: ours is faster
+}
+
+// Args: kind, triangles, Lebedev points, spatial splits. Rays of the bake's first 2000 vertices.
+void BM_HostTraversal(benchmark::State& state) {
+    const Mesh& m = mesh(int(state.range(0)), std::uint64_t(state.range(1)));
+    const SphereRule rule = parse_rule(fmt::format("lebedev:{}", state.range(2)));
+    const visibility::Bvh bvh = visibility::build_bvh(m, state.range(3) != 0);
+    visibility::EmbreeBackend embree;
+    embree.set_mesh(m, BackFaces::Occlude);
+    BakeOutputs scratch;
+    const visibility::BakeSetup s = visibility::prepare_bake(m, rule, BakeOptions{}, scratch);
+    std::vector<Ray> rays;
+    for (std::uint32_t v = 0; v < std::min<std::uint32_t>(2000, std::uint32_t(m.vertex_count())); ++v) {
+        const auto f = visibility::vertex_frame(s, m, v);
+        for (std::uint32_t j = 0; j < s.directions; ++j) {
+            glm::vec3 x;
+            float c;
+            visibility::vertex_direction(s.sorted_points[j], f.rotation, false, f.normal, x, c);
+            if (visibility::needs_ray(c))
+                rays.push_back({f.origin, 0.0f, x, s.t_max});
+        }
+    }
+    double ours = 0, theirs = 0;
+    std::uint64_t occ_ours = 0, occ_theirs = 0;
+    for (auto _ : state) {
+        occ_ours = occ_theirs = 0;
+        const auto t0 = std::chrono::steady_clock::now();
+        for (const Ray& r : rays)
+            occ_ours += visibility::bvh_occluded(bvh.view(), r.origin, r.direction, r.t_min, r.t_max, false);
+        const double a = seconds_since(t0);
+        RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+        const auto t1 = std::chrono::steady_clock::now();
+        for (const Ray& r : rays) {
+            RTCRay q{};
+            q.org_x = r.origin.x, q.org_y = r.origin.y, q.org_z = r.origin.z, q.tnear = r.t_min;
+            q.dir_x = r.direction.x, q.dir_y = r.direction.y, q.dir_z = r.direction.z;
+            q.tfar = r.t_max, q.mask = 0xffffffffu;
+            rtcOccluded1(embree.scene(), &ctx, &q);
+            occ_theirs += q.tfar < 0.0f;
+        }
+        theirs += seconds_since(t1);
+        ours += a;
+        state.SetIterationTime(a);
+    }
+    if (double(occ_ours > occ_theirs ? occ_ours - occ_theirs : occ_theirs - occ_ours) > 1e-3 * double(rays.size()))
+        state.SkipWithError("the traversals disagree");
+    const double it = double(state.iterations());
+    state.counters["rays"] = double(rays.size());
+    state.counters["ours_Mrays"] = double(rays.size()) * it / ours * 1e-6;
+    state.counters["embree1_Mrays"] = double(rays.size()) * it / theirs * 1e-6;
+    state.counters["ratio"] = theirs / ours; // > 1: ours is faster
+}
+
+} // namespace
+
+BENCHMARK(BM_GpuAo)
+    ->ArgNames({"kind", "tris", "rule", "method"})
+    ->Args({0, 3000, 5810, 0})    // the seed's table case: city, ~5k vertices, bvh
+    ->Args({0, 3000, 5810, 1})    // ... per-vertex
+    ->Args({0, 3000, 5810, 2})    // ... per-polygon
+    ->Args({1, 10000, 5810, 0})   // torus, ~5k vertices
+    ->Args({0, 1000000, 5810, 0}) // city, 1M triangles
+    ->Args({2, 1000000, 5810, 0}) // terrain, 1M triangles
+    ->Args({0, 1000000, 26, 0})   // city, 1M triangles, small rule: every method
+    ->Args({0, 1000000, 26, 1})
+    ->Args({0, 1000000, 26, 2})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
+BENCHMARK(BM_BvhBuild)
+    ->ArgNames({"kind", "tris", "splits"})
+    ->Args({0, 3000, 0})
+    ->Args({0, 3000, 1})
+    ->Args({0, 1000000, 0})
+    ->Args({0, 1000000, 1})
+    ->Args({2, 1000000, 0})
+    ->Args({2, 1000000, 1})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
+BENCHMARK(BM_HostTraversal)
+    ->ArgNames({"kind", "tris", "rule", "splits"})
+    ->Args({0, 3000, 1202, 0})
+    ->Args({0, 3000, 1202, 1})
+    ->Args({1, 10000, 1202, 0})
+    ->Args({1, 10000, 1202, 1})
+    ->Args({0, 1000000, 302, 0})
+    ->Args({0, 1000000, 302, 1})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
+
+BENCHMARK_MAIN();
