@@ -346,8 +346,9 @@ TEST(Visibility, CoherentOrderIsAPermutation) {
 }
 
 TEST(Visibility, Errors) {
-    if (cuda_device_count() == 0) // without a GPU (or CUDA) "cuda" is a clear error
+    if (cuda_device_count() == 0) { // without a GPU (or CUDA) "cuda" is a clear error
         EXPECT_THROW(make_visibility_backend("cuda"), Error);
+    }
     EXPECT_THROW(make_visibility_backend("optix"), Error);
     const Mesh big = generate_mesh({ProceduralKind::Sphere, 40000, 1});
     EXPECT_THROW(make_visibility_backend("brute")->set_mesh(big), Error);
