@@ -1,5 +1,5 @@
 # Ambient occlusion: per-vertex AO, shading coefficient A and bent normals
-# (seed 002), baked with Embree, written as glTF (any viewer shows COLOR_0 = AO)
+# (seed 002), baked with Embree (and CUDA where there is a GPU), written as glTF (any viewer shows COLOR_0 = AO)
 # with PNG previews.
 set -euo pipefail
 models=/usr/share/assimp/models
@@ -22,7 +22,13 @@ models=/usr/share/assimp/models
 # Closed form: inside the hemispherical bowl AO is exactly 1/2.
 "$SKYBAKE" ao "$OUT/bowl.glb" -o "$OUT/ao_bowl_baked.glb" --rule lebedev:1202 --json | grep -A4 '"ao"'
 
-# Bad input is one line, exit code 1.
-if "$SKYBAKE" ao "$OUT/bowl.glb" -o "$OUT/nothing.glb" --backend cuda; then
+# The table case on the GPU, with each of the CUDA backend's methods. Without
+# a GPU, asking for it is one error line, exit code 1, and no output.
+if "$SKYBAKE" --version | grep -q 'device(s)'; then
+  for method in bvh per-polygon per-vertex; do
+    "$SKYBAKE" ao "$OUT/ao_city_5k.glb" -o "$OUT/ao_city_5k_cuda_$method.glb" --rule lebedev:5810 \
+      --backend cuda --method "$method"
+  done
+elif "$SKYBAKE" ao "$OUT/bowl.glb" -o "$OUT/nothing.glb" --backend cuda; then
   echo "expected an error" >&2; exit 1
 fi

@@ -364,7 +364,8 @@ void CudaBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
         throw Error("not enough GPU memory on " + m.device + " for even one vertex of the bake (" + mib(budget) +
                         " available after the BVH); use --backend embree",
                     "--backend cuda");
-    const auto chunk = std::uint32_t(std::clamp<std::uint64_t>(std::min(work, fit), 1, std::max(n, 1u)));
+    const std::uint64_t grid = (std::uint64_t(0x7fffffff) * kBlock) / slots; // a launch has < 2^31 blocks
+    const auto chunk = std::uint32_t(std::clamp<std::uint64_t>(std::min({work, fit, grid}), 1, std::max(n, 1u)));
 
     GpuBakeParams base = host_params(plan, m.bvh);
     base.bvh = m.device_view();
