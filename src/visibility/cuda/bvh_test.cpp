@@ -181,6 +181,48 @@ TEST(CudaBvh, TraversalEqualsTheLoopOverEveryTriangle) {
         }
 }
 
+// Zero-area and repeated triangles, and a mesh far from the origin (where the
+// box padding must scale with the coordinates, not only the extent).
+TEST(CudaBvh, DegenerateRepeatedAndFarAwayTriangles) {
+    Mesh m = random_soup(9, 300);
+    const std::size_t n = m.triangle_count();
+    for (std::size_t t = 0; t < n; t += 10) { // repeated
+        for (int k = 0; k < 3; ++k)
+            m.indices.push_back(m.indices[3 * t + std::size_t(k)]);
+    }
+    for (std::size_t t = 0; t < n; t += 7) { // zero area: a repeated vertex, and three collinear points
+        m.indices.insert(m.indices.end(), {m.indices[3 * t], m.indices[3 * t], m.indices[3 * t + 1]});
+        const glm::vec3 a = m.positions[m.indices[3 * t]], b = m.positions[m.indices[3 * t + 1]];
+        const auto base = std::uint32_t(m.positions.size());
+        m.positions.insert(m.positions.end(), {a, 0.5f * (a + b), b});
+        m.indices.insert(m.indices.end(), {base, base + 1, base + 2});
+    }
+    compute_normals(m);
+    for (const glm::vec3 shift : {glm::vec3(0.0f), glm::vec3(1e5f, -3e4f, 7e4f)}) {
+        Mesh moved = m;
+        for (glm::vec3& p : moved.positions)
+            p += shift;
+        SCOPED_TRACE(shift.x);
+        const Bvh bvh = build_bvh(moved);
+        EmbreeBackend embree;
+        embree.set_mesh(moved, BackFaces::Occlude);
+        const std::vector<Ray> rays = rays_for(moved, 21, 20000, false, false);
+        std::vector<std::uint8_t> occ(rays.size());
+        embree.occluded(rays, occ);
+        std::size_t differ = 0, hits = 0;
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            const Ray& r = rays[i];
+            const bool a = bvh_occluded(bvh.view(), r.origin, r.direction, r.t_min, r.t_max, false);
+            ASSERT_EQ(a, soup_occluded(bvh.soup.data(), std::uint32_t(bvh.soup.size()), r.origin, r.direction,
+                                       r.t_min, r.t_max, false));
+            differ += a != bool(occ[i]);
+            hits += a;
+        }
+        EXPECT_GT(hits, rays.size() / 10);
+        EXPECT_LE(double(differ), 1e-4 * double(rays.size()));
+    }
+}
+
 // An independent implementation: Embree's own BVH and triangle test.
 TEST(CudaBvh, TraversalAgreesWithEmbree) {
     for (const auto& [name, m] : scenes()) {

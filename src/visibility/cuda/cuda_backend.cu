@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cstring>
 #include <string>
+#include <type_traits>
 
 #include "core/cuda_util.h"
 #include "skybake/core.h"
@@ -101,29 +102,46 @@ __global__ void reduce_kernel(GpuBakeParams p) {
         bake_reduce(p, v);
 }
 
-__global__ void occluded_kernel(BvhView bvh, const Ray* rays, std::uint8_t* out, std::uint32_t n, bool cull_back) {
+// One ray per thread: occlusion (Out = std::uint8_t) or the closest hit (Out = RayHit).
+template <class Out>
+__global__ void query_kernel(BvhView bvh, const Ray* rays, Out* out, std::uint32_t n, bool cull_back) {
     const std::uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
     if (i >= n)
         return;
     const Ray r = rays[i];
-    out[i] = bvh_occluded(bvh, r.origin, r.direction, r.t_min, r.t_max, cull_back) ? 1 : 0;
+    if constexpr (std::is_same_v<Out, RayHit>) {
+        float t = r.t_max, u = 0.0f, v = 0.0f;
+        std::uint32_t id = kNoHit;
+        RayHit h;
+        if (bvh_trace<false>(bvh, r.origin, r.direction, r.t_min, t, cull_back, id, u, v)) {
+            h.t = t;
+            h.triangle = id;
+            h.u = u;
+            h.v = v;
+        }
+        out[i] = h;
+    } else {
+        out[i] = bvh_occluded(bvh, r.origin, r.direction, r.t_min, r.t_max, cull_back) ? 1 : 0;
+    }
 }
 
-__global__ void intersect_kernel(BvhView bvh, const Ray* rays, RayHit* hits, std::uint32_t n, bool cull_back) {
-    const std::uint32_t i = blockIdx.x * blockDim.x + threadIdx.x;
-    if (i >= n)
-        return;
-    const Ray r = rays[i];
-    float t = r.t_max, u = 0.0f, v = 0.0f;
-    std::uint32_t id = kNoHit;
-    RayHit h;
-    if (bvh_trace<false>(bvh, r.origin, r.direction, r.t_min, t, cull_back, id, u, v)) {
-        h.t = t;
-        h.triangle = id;
-        h.u = u;
-        h.v = v;
+// Rays up, query_kernel, answers down, in batches of kRaysPerQuery.
+template <class Out>
+void run_queries(const BvhView& bvh, bool cull_back, std::span<const Ray> rays, std::span<Out> out,
+                 const char* what) {
+    if (rays.size() != out.size())
+        throw Error(std::string(what) + "(): the output size differs from the ray count", "cuda");
+    if (bvh.node_count == 0)
+        throw Error(std::string(what) + "(): no mesh; call set_mesh() first", "cuda");
+    cuda::DeviceBuffer<Ray> d_rays(std::min(rays.size(), kRaysPerQuery));
+    cuda::DeviceBuffer<Out> d_out(std::min(rays.size(), kRaysPerQuery));
+    for (std::size_t first = 0; first < rays.size(); first += kRaysPerQuery) {
+        const auto n = std::uint32_t(std::min(kRaysPerQuery, rays.size() - first));
+        SKYBAKE_CUDA_CHECK(cudaMemcpy(d_rays.data(), rays.data() + first, n * sizeof(Ray), cudaMemcpyHostToDevice));
+        query_kernel<Out><<<cuda::grid_for(n, kBlock), kBlock>>>(bvh, d_rays.data(), d_out.data(), n, cull_back);
+        SKYBAKE_CUDA_CHECK(cudaGetLastError());
+        SKYBAKE_CUDA_CHECK(cudaMemcpy(out.data() + first, d_out.data(), n * sizeof(Out), cudaMemcpyDeviceToHost));
     }
-    hits[i] = h;
 }
 
 // [SECTION] Host memory and streams ------------------------------------------------------------
@@ -294,39 +312,11 @@ void CudaBackend::set_mesh(const Mesh& mesh, BackFaces back_faces) {
 }
 
 void CudaBackend::occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const {
-    const Impl& m = *impl_;
-    if (rays.size() != occluded.size())
-        throw Error("occluded(): the output size differs from the ray count", "cuda");
-    if (m.nodes.size() == 0)
-        throw Error("occluded(): no mesh; call set_mesh() first", "cuda");
-    cuda::DeviceBuffer<Ray> d_rays(std::min(rays.size(), kRaysPerQuery));
-    cuda::DeviceBuffer<std::uint8_t> d_out(std::min(rays.size(), kRaysPerQuery));
-    for (std::size_t first = 0; first < rays.size(); first += kRaysPerQuery) {
-        const auto n = std::uint32_t(std::min(kRaysPerQuery, rays.size() - first));
-        SKYBAKE_CUDA_CHECK(cudaMemcpy(d_rays.data(), rays.data() + first, n * sizeof(Ray), cudaMemcpyHostToDevice));
-        occluded_kernel<<<cuda::grid_for(n, kBlock), kBlock>>>(m.device_view(), d_rays.data(), d_out.data(), n,
-                                                               m.cull_back);
-        SKYBAKE_CUDA_CHECK(cudaGetLastError());
-        SKYBAKE_CUDA_CHECK(cudaMemcpy(occluded.data() + first, d_out.data(), n, cudaMemcpyDeviceToHost));
-    }
+    run_queries(impl_->device_view(), impl_->cull_back, rays, occluded, "occluded");
 }
 
 void CudaBackend::intersect(std::span<const Ray> rays, std::span<RayHit> hits) const {
-    const Impl& m = *impl_;
-    if (rays.size() != hits.size())
-        throw Error("intersect(): the output size differs from the ray count", "cuda");
-    if (m.nodes.size() == 0)
-        throw Error("intersect(): no mesh; call set_mesh() first", "cuda");
-    cuda::DeviceBuffer<Ray> d_rays(std::min(rays.size(), kRaysPerQuery));
-    cuda::DeviceBuffer<RayHit> d_hits(std::min(rays.size(), kRaysPerQuery));
-    for (std::size_t first = 0; first < rays.size(); first += kRaysPerQuery) {
-        const auto n = std::uint32_t(std::min(kRaysPerQuery, rays.size() - first));
-        SKYBAKE_CUDA_CHECK(cudaMemcpy(d_rays.data(), rays.data() + first, n * sizeof(Ray), cudaMemcpyHostToDevice));
-        intersect_kernel<<<cuda::grid_for(n, kBlock), kBlock>>>(m.device_view(), d_rays.data(), d_hits.data(), n,
-                                                                m.cull_back);
-        SKYBAKE_CUDA_CHECK(cudaGetLastError());
-        SKYBAKE_CUDA_CHECK(cudaMemcpy(hits.data() + first, d_hits.data(), n * sizeof(RayHit), cudaMemcpyDeviceToHost));
-    }
+    run_queries(impl_->device_view(), impl_->cull_back, rays, hits, "intersect");
 }
 
 void CudaBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options, BakeOutputs& out) {

@@ -11,6 +11,7 @@
 
 #if defined(SKYBAKE_HAS_CUDA)
 #include <cstdio>
+#include <tuple>
 
 #include "skybake/error.h"
 #include "visibility/cuda/bake_plan.h"
@@ -78,6 +79,32 @@ TEST(CudaBackendGpu, EveryMethodMatchesEmbreeAndTheHostEmulation) {
                     expect_same(g, host);
                 }
             }
+}
+
+TEST(CudaBackendGpu, RealModelsMatchEmbree) {
+    SKIP_WITHOUT_GPU();
+    const std::string models = SKYBAKE_ASSIMP_MODELS;
+    const Mesh engine = load_mesh(models + "/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb");
+    const Mesh wuson = load_mesh(models + "/OBJ/WusonOBJ.obj");
+    CudaBackend cuda;
+    for (const auto& [name, m, spec] : {std::tuple<const char*, const Mesh&, const char*>{"engine", engine,
+                                                                                          "lebedev:110+rotate"},
+                                        {"wuson", wuson, "lebedev:5810"}}) {
+        const SphereRule rule = parse_rule(spec);
+        BakeOptions o;
+        o.store_bits = true;
+        BakeOutputs e;
+        make_visibility_backend("embree")->bake(m, rule, o, e);
+        for (TraceMethod method : {TraceMethod::Bvh, TraceMethod::PerVertex, TraceMethod::PerPolygon}) {
+            const std::string label = std::string(name) + " " + spec + " " + trace_method_name(method);
+            SCOPED_TRACE(label);
+            o.method = method;
+            const BakeOutputs g = gpu_bake(cuda, m, rule, o);
+            const Agreement a = compare_bakes(m, rule, o, g, e);
+            a.print(label.c_str());
+            expect_agreement(a, true);
+        }
+    }
 }
 
 TEST(CudaBackendGpu, RayQueriesEqualTheHostTraversal) {
