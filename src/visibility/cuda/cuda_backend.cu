@@ -421,6 +421,7 @@ void CudaBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
         case TraceMethod::Bvh: trace_kernel<TraceMethod::Bvh><<<blocks, kBlock, 0, st>>>(p); break;
         case TraceMethod::PerVertex: trace_kernel<TraceMethod::PerVertex><<<blocks, kBlock, 0, st>>>(p); break;
         case TraceMethod::PerPolygon: trace_tiled_kernel<<<blocks, kBlock, 0, st>>>(p); break;
+        default: throw Error("unknown trace method " + std::to_string(int(options.method)), "--method");
         }
         SKYBAKE_CUDA_CHECK(cudaGetLastError());
         reduce_kernel<<<cuda::grid_for(count, kBlock), kBlock, 0, st>>>(p);
