@@ -1,8 +1,8 @@
 # skybake: the two commands.
 #   make demo   install what is missing, build, run the demo on generated data
 #   make test   install what is missing, build, run the whole test suite
-# Other targets: build, test-fast (labels unit and io), test-sanitize, fuzz, bench,
-# install, format, clean.
+# Other targets: build, test-fast (labels unit and io), test-gpu (label gpu: on a
+# machine with a CUDA device), test-sanitize, fuzz, bench, install, format, clean.
 
 BUILD      ?= build
 BUILD_ASAN ?= build-asan
@@ -12,7 +12,7 @@ PREFIX     ?= /usr/local
 CMAKE_FLAGS ?=
 GENERATOR  := $(shell command -v ninja >/dev/null 2>&1 && echo "-G Ninja")
 
-.PHONY: all deps configure build test test-fast test-sanitize demo bench fuzz install format clean
+.PHONY: all deps configure build test test-fast test-gpu test-sanitize demo bench fuzz install format clean
 
 all: build
 
@@ -33,6 +33,10 @@ test: build
 
 test-fast: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -L 'unit|io'
+
+# The GPU tests alone, verbosely; they skip themselves without a CUDA device.
+test-gpu: build
+	ctest --test-dir $(BUILD) --output-on-failure -L gpu -V
 
 # ASan + UBSan build of the I/O tests (label "io"): hostile files must not crash.
 test-sanitize: deps
