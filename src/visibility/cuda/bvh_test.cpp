@@ -3,6 +3,7 @@
 // SKYBAKE_HD function the kernels run) against the plain loop over every
 // triangle and against Embree, and the kernels' thread bodies run on the host
 // (emulate_bake) against the Embree backend's bake.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -320,6 +321,9 @@ TEST(CudaBake, MethodNamesAndTheCpuBackendsRefuseOthers) {
     for (TraceMethod mth : {TraceMethod::Bvh, TraceMethod::PerVertex, TraceMethod::PerPolygon})
         EXPECT_EQ(parse_trace_method(trace_method_name(mth)), mth);
     EXPECT_THROW(parse_trace_method("octree"), Error);
+    const auto names = visibility_backend_names();
+    EXPECT_EQ(std::count(names.begin(), names.end(), "cuda"), build_has_cuda() ? 1 : 0);
+    EXPECT_EQ(std::count(names.begin(), names.end(), "embree"), 1);
     Mesh m = ao_test::generated(ProceduralKind::Sphere, 200);
     BakeOptions o;
     o.method = TraceMethod::PerPolygon;

@@ -366,8 +366,15 @@ void CudaBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
 
     ChunkSlot slots_[2];
     const std::uint32_t nslots = n > chunk ? 2 : 1;
-    for (std::uint32_t k = 0; k < nslots; ++k)
-        slots_[k].allocate(chunk, words, s.rotate, s.store_bits);
+    try {
+        for (std::uint32_t k = 0; k < nslots; ++k)
+            slots_[k].allocate(chunk, words, s.rotate, s.store_bits);
+    } catch (const Error&) {
+        throw Error("cannot allocate the bake's buffers on " + m.device + " (" + std::to_string(nslots) +
+                        " chunks of " + std::to_string(chunk) + " vertices, " + mib(std::uint64_t(nslots) * chunk * per_vertex) +
+                        "); free GPU memory, or use --backend embree",
+                    "--backend cuda");
+    }
 
     // Waits for a slot's chunk and stores its results.
     auto drain = [&](ChunkSlot& c) {
