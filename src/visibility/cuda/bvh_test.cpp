@@ -214,8 +214,8 @@ TEST(CudaBvh, DegenerateRepeatedAndFarAwayTriangles) {
         for (std::size_t i = 0; i < rays.size(); ++i) {
             const Ray& r = rays[i];
             const bool a = bvh_occluded(bvh.view(), r.origin, r.direction, r.t_min, r.t_max, false);
-            ASSERT_EQ(a, soup_occluded(bvh.soup.data(), std::uint32_t(bvh.soup.size()), r.origin, r.direction,
-                                       r.t_min, r.t_max, false));
+            ASSERT_EQ(a, soup_occluded(bvh.soup.data(), std::uint32_t(bvh.soup.size()), r.origin, r.direction, r.t_min,
+                                       r.t_max, false));
             differ += a != bool(occ[i]);
             hits += a;
         }

@@ -127,8 +127,7 @@ __global__ void query_kernel(BvhView bvh, const Ray* rays, Out* out, std::uint32
 
 // Rays up, query_kernel, answers down, in batches of kRaysPerQuery.
 template <class Out>
-void run_queries(const BvhView& bvh, bool cull_back, std::span<const Ray> rays, std::span<Out> out,
-                 const char* what) {
+void run_queries(const BvhView& bvh, bool cull_back, std::span<const Ray> rays, std::span<Out> out, const char* what) {
     if (rays.size() != out.size())
         throw Error(std::string(what) + "(): the output size differs from the ray count", "cuda");
     if (bvh.node_count == 0)
@@ -371,8 +370,8 @@ void CudaBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
             slots_[k].allocate(chunk, words, s.rotate, s.store_bits);
     } catch (const Error&) {
         throw Error("cannot allocate the bake's buffers on " + m.device + " (" + std::to_string(nslots) +
-                        " chunks of " + std::to_string(chunk) + " vertices, " + mib(std::uint64_t(nslots) * chunk * per_vertex) +
-                        "); free GPU memory, or use --backend embree",
+                        " chunks of " + std::to_string(chunk) + " vertices, " +
+                        mib(std::uint64_t(nslots) * chunk * per_vertex) + "); free GPU memory, or use --backend embree",
                     "--backend cuda");
     }
 

@@ -87,9 +87,9 @@ TEST(CudaBackendGpu, RealModelsMatchEmbree) {
     const Mesh engine = load_mesh(models + "/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb");
     const Mesh wuson = load_mesh(models + "/OBJ/WusonOBJ.obj");
     CudaBackend cuda;
-    for (const auto& [name, m, spec] : {std::tuple<const char*, const Mesh&, const char*>{"engine", engine,
-                                                                                          "lebedev:110+rotate"},
-                                        {"wuson", wuson, "lebedev:5810"}}) {
+    for (const auto& [name, m, spec] :
+         {std::tuple<const char*, const Mesh&, const char*>{"engine", engine, "lebedev:110+rotate"},
+          {"wuson", wuson, "lebedev:5810"}}) {
         const SphereRule rule = parse_rule(spec);
         BakeOptions o;
         o.store_bits = true;
