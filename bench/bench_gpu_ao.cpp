@@ -10,6 +10,13 @@
 // BM_HostTraversal: the SKYBAKE_HD traversal the kernels run, on one CPU
 //   thread, against rtcOccluded1 on the same rays, also on one thread: a
 //   measure of the BVH's quality that needs no GPU. Runs anywhere.
+// BM_WarpModel: the kernels' warp layout, counted on the host. Each warp's 32
+//   lanes are traced with the traversal's counters (nodes + triangles per
+//   lane); a warp runs as long as its longest lane, so its cost is 32 × that
+//   maximum and its SIMT efficiency the lanes' sum over the cost. Directions in
+//   the coherent visiting order (what the kernels use) against the rule's own
+//   order (the baseline): the ratio of the costs is the speed-up the order
+//   buys. A model, not a timing; runs anywhere.
 #include <chrono>
 #include <map>
 #include <memory>
@@ -179,6 +186,62 @@ void BM_HostTraversal(benchmark::State& state) {
     state.counters["ratio"] = theirs / ours; // > 1: ours is faster
 }
 
+// Args: kind, triangles, Lebedev points. The first 1000 vertices.
+void BM_WarpModel(benchmark::State& state) {
+    const Mesh& m = mesh(int(state.range(0)), std::uint64_t(state.range(1)));
+    const SphereRule rule = parse_rule(fmt::format("lebedev:{}", state.range(2)));
+    const visibility::Bvh bvh = visibility::build_bvh(m);
+    BakeOutputs scratch;
+    const visibility::BakeSetup s = visibility::prepare_bake(m, rule, BakeOptions{}, scratch);
+    const std::uint32_t vertices = std::min<std::uint32_t>(1000, std::uint32_t(m.vertex_count()));
+    struct Model {
+        double useful = 0, cost = 0, nodes = 0, triangles = 0, rays = 0;
+    };
+    // Warp cost over all (vertex, word) warps with directions taken from `points`.
+    auto model = [&](const std::vector<glm::vec3>& points) {
+        Model r;
+        for (std::uint32_t v = 0; v < vertices; ++v) {
+            const auto f = visibility::vertex_frame(s, m, v);
+            for (std::uint32_t w = 0; w < s.words; ++w) {
+                std::uint32_t longest = 0, sum = 0;
+                for (std::uint32_t lane = 0; lane < 32 && 32 * w + lane < s.directions; ++lane) {
+                    glm::vec3 x;
+                    float c;
+                    visibility::vertex_direction(points[32 * w + lane], f.rotation, false, f.normal, x, c);
+                    if (!visibility::needs_ray(c))
+                        continue;
+                    visibility::TraversalCounts n;
+                    float t = s.t_max, u, vv;
+                    std::uint32_t id = kNoHit;
+                    visibility::bvh_trace<true>(bvh.view(), f.origin, x, 0.0f, t, false, id, u, vv, &n);
+                    const std::uint32_t steps = n.nodes + n.triangles;
+                    longest = std::max(longest, steps);
+                    sum += steps;
+                    r.nodes += n.nodes;
+                    r.triangles += n.triangles;
+                    r.rays += 1;
+                }
+                r.useful += sum;
+                r.cost += 32.0 * longest;
+            }
+        }
+        return r;
+    };
+    Model coherent, plain;
+    for (auto _ : state) {
+        const auto t0 = std::chrono::steady_clock::now();
+        coherent = model(s.sorted_points);
+        plain = model(s.points);
+        state.SetIterationTime(seconds_since(t0));
+    }
+    state.counters["rays"] = coherent.rays;
+    state.counters["nodes_per_ray"] = coherent.nodes / coherent.rays;
+    state.counters["tris_per_ray"] = coherent.triangles / coherent.rays;
+    state.counters["simt_coherent"] = coherent.useful / coherent.cost;
+    state.counters["simt_rule_order"] = plain.useful / plain.cost;
+    state.counters["speedup"] = plain.cost / coherent.cost;
+}
+
 } // namespace
 
 BENCHMARK(BM_GpuAo)
@@ -217,5 +280,16 @@ BENCHMARK(BM_HostTraversal)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond)
     ->Iterations(3);
+
+BENCHMARK(BM_WarpModel)
+    ->ArgNames({"kind", "tris", "rule"})
+    ->Args({0, 3000, 5810})    // the seed's table case
+    ->Args({1, 10000, 5810})   // torus
+    ->Args({0, 1000000, 5810}) // city, 1M triangles
+    ->Args({0, 3000, 590})
+    ->Args({0, 1000000, 110})
+    ->UseManualTime()
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1);
 
 BENCHMARK_MAIN();

@@ -20,6 +20,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -188,9 +189,19 @@ SKYBAKE_HD_INLINE glm::vec3 inverse_direction(const glm::vec3& d) {
 // something was hit. AnyHit: stops at the first hit found (occlusion); else
 // returns the closest, ties broken by the lower mesh triangle index so that the
 // answer does not depend on the tree: t_max, hit_id, u, v are then updated.
-template <bool AnyHit>
+// Counts: TraversalCounts to count the work (nodes visited, triangles
+// tested), as the benchmarks do to model a warp's cost; by default nothing.
+struct NoTraversalCounts {};
+struct TraversalCounts {
+    std::uint32_t nodes = 0;
+    std::uint32_t triangles = 0;
+};
+
+template <bool AnyHit, class Counts = NoTraversalCounts>
 SKYBAKE_HD_INLINE bool bvh_trace(const BvhView& bvh, const glm::vec3& o, const glm::vec3& d, float t_min, float& t_max,
-                                 bool cull_back, std::uint32_t& hit_id, float& hit_u, float& hit_v) {
+                                 bool cull_back, std::uint32_t& hit_id, float& hit_u, float& hit_v,
+                                 Counts* counts = nullptr) {
+    constexpr bool kCount = !std::is_same_v<Counts, NoTraversalCounts>;
     using namespace bvh_detail;
     const glm::vec3 inv_d = inverse_direction(d);
     std::int32_t stack[kBvhStackSize];
@@ -200,6 +211,8 @@ SKYBAKE_HD_INLINE bool bvh_trace(const BvhView& bvh, const glm::vec3& o, const g
     for (;;) {
         if (cur >= 0) {
             const BvhNode n = load_node(bvh.nodes, cur);
+            if constexpr (kCount)
+                ++counts->nodes;
             // Constant indices only, so that the node stays in registers on the GPU.
             const std::int32_t c0 = n.child[0], c1 = n.child[1];
             float t0, t1;
@@ -220,6 +233,8 @@ SKYBAKE_HD_INLINE bool bvh_trace(const BvhView& bvh, const glm::vec3& o, const g
             decode_leaf(cur, first, count);
             for (std::uint32_t i = first; i < first + count; ++i) {
                 const BvhTriangle tri = load_triangle(bvh.triangles, i);
+                if constexpr (kCount)
+                    ++counts->triangles;
                 float t, u, v;
                 if (!ray_triangle(o, d, tri.p0, tri.e1, tri.e2, t_min, t_max, t, u, v, cull_back))
                     continue;

@@ -182,6 +182,34 @@ TEST(CudaBvh, TraversalEqualsTheLoopOverEveryTriangle) {
         }
 }
 
+// The counting traversal (benchmarks) answers as the plain one, and a ray that
+// misses the root's boxes visits the root only.
+TEST(CudaBvh, CountedTraversalAnswersTheSame) {
+    const Mesh m = ao_test::generated(ProceduralKind::Torus, 2000);
+    const Bvh bvh = build_bvh(m);
+    std::uint64_t nodes = 0;
+    for (const Ray& r : rays_for(m, 4, 2000, false)) {
+        TraversalCounts n;
+        float t = r.t_max, u, v;
+        std::uint32_t id = kNoHit;
+        const bool counted = bvh_trace<true>(bvh.view(), r.origin, r.direction, r.t_min, t, false, id, u, v, &n);
+        ASSERT_EQ(counted, bvh_occluded(bvh.view(), r.origin, r.direction, r.t_min, r.t_max, false));
+        ASSERT_GE(n.nodes, 1u);
+        if (counted) {
+            ASSERT_GE(n.triangles, 1u);
+        }
+        nodes += n.nodes;
+    }
+    EXPECT_LT(double(nodes) / 2000.0, 0.2 * double(bvh.nodes.size())); // far fewer than all
+    TraversalCounts away;
+    float t = INFINITY, u, v;
+    std::uint32_t id = kNoHit;
+    const glm::vec3 far = compute_bounds(m).max + glm::vec3(10.0f);
+    EXPECT_FALSE(bvh_trace<true>(bvh.view(), far, glm::vec3(0, 1, 0), 0.0f, t, false, id, u, v, &away));
+    EXPECT_EQ(away.nodes, 1u);
+    EXPECT_EQ(away.triangles, 0u);
+}
+
 // Zero-area and repeated triangles, and a mesh far from the origin (where the
 // box padding must scale with the coordinates, not only the extent).
 TEST(CudaBvh, DegenerateRepeatedAndFarAwayTriangles) {
