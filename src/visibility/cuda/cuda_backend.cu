@@ -20,6 +20,7 @@
 #include <type_traits>
 
 #include "core/cuda_util.h"
+#include "core/progress.h"
 #include "skybake/core.h"
 #include "skybake/error.h"
 #include "skybake/mesh.h"
@@ -375,6 +376,7 @@ void CudaBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
                     "--backend cuda");
     }
 
+    Progress progress("ao", n);
     // Waits for a slot's chunk and stores its results.
     auto drain = [&](ChunkSlot& c) {
         if (!c.busy)
@@ -385,6 +387,7 @@ void CudaBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
                      s.store_bits ? c.h_rule_words.data() : nullptr},
                     out);
         c.busy = false;
+        progress.advance(c.count);
     };
 
     out.rays = 0;
@@ -444,6 +447,7 @@ void CudaBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
     }
     for (std::uint32_t k = 0; k < nslots; ++k)
         drain(slots_[k]);
+    progress.finish();
     out.trace_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
 }
 
