@@ -145,6 +145,11 @@ public:
         const auto index = std::int32_t(out_.nodes.size());
         out_.nodes.emplace_back();
         for (int c = 0; c < 2; ++c) {
+            if (!n->child[c]) { // a node with one child: the other is an empty leaf in the same box
+                set_box(std::size_t(index), c, n->bounds[0]);
+                out_.nodes[std::size_t(index)].child[c] = encode_leaf(0, 0);
+                continue;
+            }
             set_box(std::size_t(index), c, n->bounds[c]);
             const std::int32_t child = emit(n->child[c], depth + 1);
             out_.nodes[std::size_t(index)].child[c] = child;
