@@ -15,10 +15,10 @@
 // Thread layout: one warp per (vertex, 32 consecutive directions in the
 // rule's coherent visiting order). A warp's rays leave one point towards one
 // small patch of the sphere and walk the BVH together; the warp's answers are
-// one visibility word (__ballot_sync), in visiting order. A second pass, one
-// thread per vertex, reduces a vertex's words to AO, A and the bent normal in
-// the same order and arithmetic as the CPU backends (shading_hd.h), and
-// scatters the bits to rule order.
+// one visibility word (__ballot_sync), in visiting order. A second pass,
+// eight threads per vertex (one per partial sum), reduces a vertex's words to
+// AO, A and the bent normal with the same additions in the same order as the
+// CPU backends (shading_hd.h), and scatters the bits to rule order.
 #pragma once
 
 #include <cstdint>
@@ -90,40 +90,62 @@ SKYBAKE_HD_INLINE bool bake_visible(const GpuBakeParams& p, std::uint32_t v, std
         return !soup_occluded(p.soup, p.soup_count, o, d, 0.0f, p.t_max, p.cull_back);
 }
 
-// Reduces chunk vertex v's visiting-order words to its outputs.
-SKYBAKE_HD_INLINE void bake_reduce(const GpuBakeParams& p, std::uint32_t v) {
+// The reduction is split over kReduceLanes threads per vertex, one per
+// partial sum of shading_hd.h: thread l adds directions j = l, l + 8, l + 16,
+// ... into its partial, exactly the additions the sequential loop makes into
+// partial l, so the split changes no bit of the result.
+
+// Partial l of chunk vertex v, from its visiting-order words (in lane 0 of
+// `s`, which must start zeroed); also sets v's visible bits of those
+// directions in rule order (store_bits). Returns the rays traced among them.
+SKYBAKE_HD_INLINE std::uint32_t bake_reduce_lane(const GpuBakeParams& p, std::uint32_t v, std::uint32_t l,
+                                                 ShadingPartials& s) {
     const glm::vec3 n = p.normals[v];
     const glm::mat3 r = p.rotate ? p.rotations[v] : glm::mat3(1.0f);
     const std::uint32_t* vis = p.visit_words + std::size_t(v) * p.words;
     std::uint32_t* out = p.store_bits ? p.rule_words + std::size_t(v) * p.words : nullptr;
-    ShadingPartials s;
     std::uint32_t traced = 0;
-    // Lane l of each group of kReduceLanes is a constant after unrolling: the
-    // partial sums stay in registers.
-    for (std::uint32_t j0 = 0; j0 < p.directions; j0 += kReduceLanes) {
+    for (std::uint32_t j = l; j < p.directions; j += kReduceLanes) {
+        glm::vec3 x;
+        float c;
+        vertex_direction(p.points[j], r, p.rotate, n, x, c);
+        const bool seen = get_bit(vis, j);
+        add_direction(s, 0, p.weights[j], c, x.x, x.y, x.z, seen ? 1.0f : 0.0f);
+        traced += needs_ray(c) ? 1u : 0u;
+        if (seen && out) {
 #if defined(__CUDA_ARCH__)
-#pragma unroll
+            atomicOr(out + (p.order[j] >> 5), 1u << (p.order[j] & 31u)); // the lanes share words
+#else
+            set_bit(out, p.order[j]);
 #endif
-        for (std::uint32_t l = 0; l < kReduceLanes; ++l) {
-            const std::uint32_t j = j0 + l;
-            if (j >= p.directions)
-                break;
-            glm::vec3 x;
-            float c;
-            vertex_direction(p.points[j], r, p.rotate, n, x, c);
-            const bool seen = get_bit(vis, j);
-            add_direction(s, l, p.weights[j], c, x.x, x.y, x.z, seen ? 1.0f : 0.0f);
-            traced += needs_ray(c) ? 1u : 0u;
-            if (seen && out)
-                set_bit(out, p.order[j]);
         }
     }
-    const Shading sh = finish_shading(combine_partials(s), n, p.normalize);
+    return traced;
+}
+
+// Combines vertex v's partials (lane l of `all` = partial l, in lane order)
+// and stores its outputs.
+SKYBAKE_HD_INLINE void bake_store(const GpuBakeParams& p, std::uint32_t v, const ShadingPartials& all,
+                                  std::uint32_t traced) {
+    const Shading sh = finish_shading(combine_partials(all), p.normals[v], p.normalize);
     p.ao[v] = sh.ao;
     p.shading[v] = sh.shading;
     p.bent[v] = sh.bent_normal;
     p.rays[v] = traced;
     p.clamped[v] = sh.clamped ? 1u : 0u;
+}
+
+// The whole reduction of chunk vertex v on one thread.
+inline void bake_reduce(const GpuBakeParams& p, std::uint32_t v) {
+    ShadingPartials all;
+    std::uint32_t traced = 0;
+    for (std::uint32_t l = 0; l < kReduceLanes; ++l) {
+        ShadingPartials s;
+        traced += bake_reduce_lane(p, v, l, s);
+        all.ao[l] = s.ao[0], all.ao_open[l] = s.ao_open[0], all.a[l] = s.a[0], all.a_open[l] = s.a_open[0];
+        all.bx[l] = s.bx[0], all.by[l] = s.by[0], all.bz[l] = s.bz[0];
+    }
+    bake_store(p, v, all, traced);
 }
 
 // The whole chunk on the host, thread by thread as the kernels run it.

@@ -97,10 +97,35 @@ __global__ void __launch_bounds__(kBlock) trace_tiled_kernel(GpuBakeParams p) {
         p.visit_words[warp] = bits;
 }
 
-__global__ void reduce_kernel(GpuBakeParams p) {
-    const std::uint32_t v = blockIdx.x * blockDim.x + threadIdx.x;
-    if (v < p.vertex_count)
-        bake_reduce(p, v);
+// kReduceLanes threads per vertex, one per partial sum; the group's first
+// thread gathers the partials in lane order and stores the vertex.
+__global__ void __launch_bounds__(kBlock) reduce_kernel(GpuBakeParams p) {
+    static_assert(32 % kReduceLanes == 0);
+    const std::uint32_t t = blockIdx.x * blockDim.x + threadIdx.x;
+    const std::uint32_t v = t / kReduceLanes, l = t % kReduceLanes;
+    const bool active = v < p.vertex_count;
+    ShadingPartials s;
+    std::uint32_t traced = 0;
+    if (active)
+        traced = bake_reduce_lane(p, v, l, s);
+    // Every lane of the warp takes part in the shuffles.
+    const unsigned first = (threadIdx.x & 31u) & ~(kReduceLanes - 1u);
+    ShadingPartials all;
+    std::uint32_t total = 0;
+#pragma unroll
+    for (std::uint32_t k = 0; k < kReduceLanes; ++k) {
+        const unsigned src = first + k;
+        all.ao[k] = __shfl_sync(0xffffffffu, s.ao[0], src);
+        all.ao_open[k] = __shfl_sync(0xffffffffu, s.ao_open[0], src);
+        all.a[k] = __shfl_sync(0xffffffffu, s.a[0], src);
+        all.a_open[k] = __shfl_sync(0xffffffffu, s.a_open[0], src);
+        all.bx[k] = __shfl_sync(0xffffffffu, s.bx[0], src);
+        all.by[k] = __shfl_sync(0xffffffffu, s.by[0], src);
+        all.bz[k] = __shfl_sync(0xffffffffu, s.bz[0], src);
+        total += __shfl_sync(0xffffffffu, traced, src);
+    }
+    if (active && l == 0)
+        bake_store(p, v, all, total);
 }
 
 // One ray per thread: occlusion (Out = std::uint8_t) or the closest hit (Out = RayHit).
@@ -433,7 +458,7 @@ void CudaBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
         default: throw Error("unknown trace method " + std::to_string(int(options.method)), "--method");
         }
         SKYBAKE_CUDA_CHECK(cudaGetLastError());
-        reduce_kernel<<<cuda::grid_for(count, kBlock), kBlock, 0, st>>>(p);
+        reduce_kernel<<<cuda::grid_for(std::size_t(count) * kReduceLanes, kBlock), kBlock, 0, st>>>(p);
         SKYBAKE_CUDA_CHECK(cudaGetLastError());
 
         c.ao.download(c.h_ao.data(), count, st);
