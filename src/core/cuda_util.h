@@ -2,6 +2,7 @@
 // skybake::Error, and an owning device buffer. Include only from .cu files.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -44,6 +45,13 @@ public:
         resize(n);
         if (n > 0)
             SKYBAKE_CUDA_CHECK(cudaMemcpyAsync(ptr_, src, n * sizeof(T), cudaMemcpyHostToDevice, stream));
+    }
+    // Copies n ≤ size() elements into the start of the buffer, keeping its size
+    // (upload() resizes to n).
+    void upload_prefix(const T* src, std::size_t n, cudaStream_t stream = nullptr) {
+        if (n > 0)
+            SKYBAKE_CUDA_CHECK(
+                cudaMemcpyAsync(ptr_, src, std::min(n, size_) * sizeof(T), cudaMemcpyHostToDevice, stream));
     }
     void download(T* dst, std::size_t n, cudaStream_t stream = nullptr) const {
         if (n > 0)

@@ -253,13 +253,6 @@ std::uint64_t bytes_per_vertex(std::uint32_t words, bool rotate, bool store_bits
     return b;
 }
 
-// Asynchronous copy into the first n entries of a buffer allocated for the whole chunk.
-template <class T>
-void to_device(cuda::DeviceBuffer<T>& dst, const T* src, std::size_t n, cudaStream_t stream) {
-    if (n > 0)
-        SKYBAKE_CUDA_CHECK(cudaMemcpyAsync(dst.data(), src, n * sizeof(T), cudaMemcpyHostToDevice, stream));
-}
-
 std::string mib(std::uint64_t bytes) {
     return std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB";
 }
@@ -429,10 +422,10 @@ void CudaBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
         if (s.rotate)
             std::copy_n(plan.rotations.data() + first, count, c.h_rotations.data());
         const cudaStream_t st = c.stream;
-        to_device(c.origins, c.h_origins.data(), count, st);
-        to_device(c.normals, c.h_normals.data(), count, st);
+        c.origins.upload_prefix(c.h_origins.data(), count, st);
+        c.normals.upload_prefix(c.h_normals.data(), count, st);
         if (s.rotate)
-            to_device(c.rotations, c.h_rotations.data(), count, st);
+            c.rotations.upload_prefix(c.h_rotations.data(), count, st);
         if (s.store_bits)
             SKYBAKE_CUDA_CHECK(cudaMemsetAsync(c.rule_words.data(), 0, std::size_t(count) * words * 4, st));
 
