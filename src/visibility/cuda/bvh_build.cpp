@@ -124,7 +124,8 @@ BvhTriangle make_triangle(const Mesh& mesh, std::uint32_t t) {
 // order the leaves are met.
 class Flattener {
 public:
-    Flattener(const Mesh& mesh, Bvh& out, float pad) : mesh_(mesh), out_(out), pad_(pad) {}
+    // out.soup must be filled: leaves copy their triangles from it.
+    Flattener(Bvh& out, float pad) : out_(out), pad_(pad) {}
 
     // Appends `node` and returns its encoded child reference.
     std::int32_t emit(const BuildNode* node, int depth) {
@@ -138,7 +139,7 @@ public:
                                         kMaxBvhTriangleRefs),
                             "--backend cuda");
             for (std::uint32_t k = 0; k < l->count; ++k)
-                out_.triangles.push_back(make_triangle(mesh_, l->ids[k]));
+                out_.triangles.push_back(out_.soup[l->ids[k]]);
             return encode_leaf(first, l->count);
         }
         const auto* n = static_cast<const BuildInner*>(node);
@@ -165,7 +166,6 @@ public:
     }
 
 private:
-    const Mesh& mesh_;
     Bvh& out_;
     float pad_;
 };
@@ -265,7 +265,7 @@ Bvh build_bvh(const Mesh& mesh, bool spatial_splits) {
     if (ctx.leaf_overflow)
         throw Error(fmt::format("Embree built a leaf of more than {} triangles", kMaxLeafTriangles), "--backend cuda");
 
-    Flattener flat(mesh, out, pad);
+    Flattener flat(out, pad);
     out.nodes.reserve(2 * nt / kMaxLeafTriangles + 16);
     out.triangles.reserve(nt + nt / 4);
     if (root->leaf) {
