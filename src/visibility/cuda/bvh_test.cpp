@@ -38,15 +38,6 @@ bool box_inside(const float* inner, const float* outer) {
            inner[4] >= outer[4] && inner[5] <= outer[5];
 }
 
-BakeOutputs emulated(const Mesh& m, const SphereRule& rule, const BakeOptions& o, TraceMethod method,
-                     std::uint32_t chunk = 4096) {
-    BakeOutputs out;
-    const BakePlan plan = plan_bake(m, rule, o, out);
-    const Bvh bvh = build_bvh(m);
-    emulate_bake(plan, bvh, method, out, chunk);
-    return out;
-}
-
 } // namespace
 
 TEST(CudaBvh, StructureHoldsEveryTriangleInNestedBoxes) {

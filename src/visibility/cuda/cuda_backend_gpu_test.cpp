@@ -34,13 +34,6 @@ BakeOutputs gpu_bake(CudaBackend& cuda, const Mesh& m, const SphereRule& rule, c
     return out;
 }
 
-BakeOutputs host_emulation(const Mesh& m, const SphereRule& rule, const BakeOptions& o, TraceMethod method) {
-    BakeOutputs out;
-    const BakePlan plan = plan_bake(m, rule, o, out);
-    emulate_bake(plan, build_bvh(m), method, out);
-    return out;
-}
-
 void expect_same(const BakeOutputs& a, const BakeOutputs& b) {
     EXPECT_EQ(a.visibility_bits, b.visibility_bits);
     EXPECT_EQ(a.ao, b.ao);
@@ -66,7 +59,7 @@ TEST(CudaBackendGpu, EveryMethodMatchesEmbreeAndTheHostEmulation) {
                 o.back_faces = back;
                 BakeOutputs e;
                 make_visibility_backend("embree")->bake(m, rule, o, e);
-                const BakeOutputs host = host_emulation(m, rule, o, TraceMethod::Bvh);
+                const BakeOutputs host = emulated(m, rule, o, TraceMethod::Bvh);
                 for (TraceMethod method : {TraceMethod::Bvh, TraceMethod::PerVertex, TraceMethod::PerPolygon}) {
                     const std::string label =
                         name + " " + spec + " " + back_faces_name(back) + " " + trace_method_name(method);

@@ -18,6 +18,7 @@
 #include "skybake/sphere.h"
 #include "skybake/visibility.h"
 #include "visibility/bake_common.h"
+#include "visibility/cuda/bake_plan.h"
 #include "visibility/cuda/bvh.h"
 #include "visibility/embree/embree_backend.h"
 
@@ -113,6 +114,16 @@ inline bool is_tie(const Mesh& m, const Ray& r, std::uint32_t id) {
     const double v = glm::dot(glm::cross(e1, q), n) / a, u = glm::dot(glm::cross(q, e2), n) / a;
     const double edge = std::min({u, v, 1.0 - u - v});
     return std::abs(edge) < 1e-5 || (std::isfinite(r.t_max) && std::abs(t - double(r.t_max)) < 1e-5 * r.t_max);
+}
+
+// The CUDA bake's thread bodies run on the host (emulate_bake), in chunks of
+// `chunk` vertices.
+inline BakeOutputs emulated(const Mesh& m, const SphereRule& rule, const BakeOptions& o, TraceMethod method,
+                            std::uint32_t chunk = 4096) {
+    BakeOutputs out;
+    const BakePlan plan = plan_bake(m, rule, o, out);
+    emulate_bake(plan, build_bvh(m), method, out, chunk);
+    return out;
 }
 
 // How a bake compares with a reference bake of the same inputs.
