@@ -24,6 +24,7 @@
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
 
+#include "ao_scenes.h"
 #include "core/parallel.h"
 #include "skybake/bake.h"
 #include "skybake/core.h"
@@ -47,11 +48,8 @@ struct Scene {
     std::vector<RTCRay> rays;
 };
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-ProceduralKind kind_of(int k) { return k == 0 ? ProceduralKind::City : k == 1 ? ProceduralKind::Torus : ProceduralKind::Terrain; }
+using bench::kind_of;
+using bench::seconds_since;
 
 Scene& scene(int kind, std::uint64_t triangles, const std::string& rule, bool with_rays) {
     static std::map<std::string, std::unique_ptr<Scene>> cache;

@@ -25,6 +25,7 @@
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
 
+#include "ao_scenes.h"
 #include "skybake/core.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
@@ -38,13 +39,8 @@ using namespace skybake;
 
 namespace {
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-ProceduralKind kind_of(int k) {
-    return k == 0 ? ProceduralKind::City : k == 1 ? ProceduralKind::Torus : ProceduralKind::Terrain;
-}
+using bench::kind_of;
+using bench::seconds_since;
 
 const Mesh& mesh(int kind, std::uint64_t triangles) {
     static std::map<std::pair<int, std::uint64_t>, std::unique_ptr<Mesh>> cache;
