@@ -8,13 +8,13 @@
 #include "cli_runner.h"
 #include "skybake/bake.h"
 #include "skybake/core.h"
+#include "core/gpu_test.h"
 
 using skybake::test::run_cli;
 namespace fs = std::filesystem;
 
 TEST(AoGpuCli, EveryMethodMatchesEmbree) {
-    if (skybake::cuda_device_count() == 0)
-        GTEST_SKIP() << "no CUDA device";
+    SKYBAKE_SKIP_WITHOUT_GPU();
     const std::string dir = skybake::test::temp_dir("ao-gpu-cli");
     const std::string city = dir + "/city.glb";
     ASSERT_EQ(run_cli({"mesh", "generate", "--kind", "city", "--triangles", "5000", "-o", city}).exit_code, 0);

@@ -1,5 +1,6 @@
 // End-to-end tests of the neural sky commands: sky train, sky eval/render
 // --model, sky export, sky error; exit codes, one-line errors, no partial output.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -9,6 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
+#include "skybake/neural.h"
+#include "skybake/sky.h"
 
 using skybake::test::run_cli;
 using skybake::test::temp_dir;
@@ -102,15 +105,29 @@ TEST(NeuralCli, EvalWithModelTakesTheSameCsv) {
     std::string line;
     std::getline(out, line);
     EXPECT_EQ(line, "r,g,b");
-    int rows = 0;
+    // The library's batch inference on the same samples: the CLI is a thin
+    // shell over it, so the rows agree to the 9 printed digits.
+    const skybake::NeuralSky net = skybake::load_neural_sky(tiny_model());
+    const std::vector<skybake::SkySample> samples = {
+        {1, 1, 1, 1}, {0.5f, 0.2f, 0.7f, 0.3f}, {-0.2f, 0.1f, 0.5f, 0.9f}, {0.3f, -0.285f, -0.95f, 0.5f}};
+    std::vector<glm::vec3> expected(samples.size());
+    skybake::evaluate_neural_sky(net, samples, expected);
+    int rows = 0, lit = 0;
     while (std::getline(out, line)) {
-        double a, b, c;
-        char k1, k2;
+        ASSERT_LT(rows, 4) << line;
+        double a = -1, b = -1, c = -1;
+        char k1 = 0, k2 = 0;
         std::istringstream(line) >> a >> k1 >> b >> k2 >> c;
-        EXPECT_TRUE(std::isfinite(a) && a >= 0 && b >= 0 && c >= 0) << line;
+        const glm::vec3& e = expected[std::size_t(rows)];
+        const double scale = std::max({double(e.x), double(e.y), double(e.z), 1e-30});
+        EXPECT_NEAR(a, e.x, 1e-6 * scale) << "row " << rows << ": " << line;
+        EXPECT_NEAR(b, e.y, 1e-6 * scale) << "row " << rows << ": " << line;
+        EXPECT_NEAR(c, e.z, 1e-6 * scale) << "row " << rows << ": " << line;
+        lit += e.x > 0.0f;
         ++rows;
     }
     EXPECT_EQ(rows, 4);
+    EXPECT_GE(lit, 2) << "the sunlit samples must not all decode to zero";
     // The same bad input errors as the reference model.
     const std::string bad = write(dir, "bad.csv", "1,1,1,1\n0.9,0.9,-0.9,0.5\n");
     auto e = run_cli({"sky", "eval", "--model", tiny_model(), "--input", bad, "--output", dir + "/bad_out.csv"});

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
+#include "skybake/sky.h"
 
 using skybake::test::run_cli;
 using skybake::test::temp_dir;
@@ -51,6 +52,53 @@ TEST(SkyCli, PresetRoundTripsThroughAFile) {
     ASSERT_EQ(a.exit_code, 0) << a.err;
     ASSERT_EQ(b.exit_code, 0) << b.err;
     EXPECT_EQ(last_line_number(a.out), last_line_number(b.out));
+}
+
+namespace {
+
+// Every field of two atmospheres, exactly (JSON numbers round-trip doubles).
+void expect_same_atmosphere(const skybake::Atmosphere& a, const skybake::Atmosphere& b, const std::string& what) {
+    SCOPED_TRACE(what);
+    EXPECT_EQ(a.name, b.name);
+    EXPECT_EQ(a.planet_radius_km, b.planet_radius_km);
+    EXPECT_EQ(a.top_radius_km, b.top_radius_km);
+    EXPECT_EQ(a.sun_elevation_deg, b.sun_elevation_deg);
+    EXPECT_EQ(a.sun_azimuth_deg, b.sun_azimuth_deg);
+    EXPECT_EQ(a.sun_irradiance, b.sun_irradiance);
+    EXPECT_EQ(a.sun_angular_radius_rad, b.sun_angular_radius_rad);
+    EXPECT_EQ(a.ground_albedo, b.ground_albedo);
+    EXPECT_EQ(a.table_rule, b.table_rule);
+    ASSERT_EQ(a.components.size(), b.components.size());
+    for (std::size_t k = 0; k < a.components.size(); ++k) {
+        const auto &x = a.components[k], &y = b.components[k];
+        SCOPED_TRACE("component " + std::to_string(k));
+        EXPECT_EQ(x.name, y.name);
+        EXPECT_EQ(x.profile, y.profile);
+        EXPECT_EQ(x.scale_height_km, y.scale_height_km);
+        EXPECT_EQ(x.tent_center_km, y.tent_center_km);
+        EXPECT_EQ(x.tent_half_width_km, y.tent_half_width_km);
+        EXPECT_EQ(x.scattering_per_km, y.scattering_per_km);
+        EXPECT_EQ(x.extinction_per_km, y.extinction_per_km);
+        EXPECT_EQ(x.phase, y.phase);
+        EXPECT_EQ(x.phase_g, y.phase_g);
+    }
+}
+
+} // namespace
+
+TEST(SkyCli, EveryPresetRoundTripsEveryField) {
+    // `sky preset NAME` prints the preset as JSON; reading it back (as
+    // --atmosphere does) must give the library's preset field for field.
+    const auto names = skybake::atmosphere_preset_names();
+    ASSERT_GE(names.size(), 3u);
+    for (const std::string& name : names) {
+        auto r = run_cli({"sky", "preset", name});
+        ASSERT_EQ(r.exit_code, 0) << name << ": " << r.err;
+        const skybake::Atmosphere preset = skybake::atmosphere_preset(name);
+        expect_same_atmosphere(skybake::atmosphere_from_json(r.out), preset, name + " through the CLI");
+        expect_same_atmosphere(skybake::atmosphere_from_json(skybake::atmosphere_to_json(preset)), preset,
+                               name + " through the library");
+    }
 }
 
 TEST(SkyCli, OpticalLengthStraightUpIsTheScaleHeight) {

@@ -11,8 +11,14 @@ namespace skybake {
 const char* version();
 // True when this build compiled the CUDA backends (a GPU may still be absent).
 bool build_has_cuda();
-// Number of CUDA devices usable now; 0 without CUDA or without a GPU.
+// Number of CUDA devices usable now; 0 without CUDA, without a GPU, or when
+// the CUDA runtime cannot talk to the driver (cuda_device_problem() says why).
 int cuda_device_count();
+// Why cuda_device_count() is 0, in one line: "this build has no CUDA support",
+// or the CUDA runtime's error name and text (cudaErrorNoDevice,
+// cudaErrorInsufficientDriver for a missing or old driver,
+// cudaErrorSystemDriverMismatch, ...). Empty when a device is usable.
+std::string cuda_device_problem();
 // Name of CUDA device 0, or an empty string.
 std::string cuda_device_name();
 // Throws skybake::Error, naming `where` (e.g. "--device cuda"), when this

@@ -24,6 +24,7 @@
 
 #include "bake/ao_test_util.h"
 #include "skybake/bake.h"
+#include "skybake/core.h"
 #include "skybake/error.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
@@ -283,18 +284,64 @@ TEST(AmbientOcclusion, LebedevErrorFallsWithPrecision) {
 }
 
 TEST(AmbientOcclusion, BentNormalLeansAwayFromTheWall) {
+    // The bent normal is the cosine-weighted mean open direction,
+    // normalise(Σ_k w_k (n·x_k)+ V_k x_k): compared with that sum over the
+    // exact wall, so a uniform weighting (45° tilt for a half-blocked
+    // hemisphere against 32.5° with the cosine) or a lost sign fails.
+    // The reference starts its rays where the bake does, at p + offset · n,
+    // since a ray that grazes the wall's top edge flips with the origin's
+    // height (one direction moves the bent normal by about 4e-3).
     Mesh m = generated(ProceduralKind::Wall, 2000);
-    bake_ambient_occlusion(m, parse_rule("lebedev:590"));
+    const SphereRule rule = parse_rule("lebedev:590+rotate");
+    BakeOptions o;
+    o.ray_offset = 1e-5f;
+    bake_ambient_occlusion(m, rule, "embree", o);
     const auto& bent = m.find_attribute("bent_normal")->values;
+    std::size_t tested = 0;
+    double worst = 0.0;
     for (std::size_t v = 0; v < m.vertex_count(); ++v) {
-        const glm::vec3 p = m.positions[v];
-        if (p.y != 0.0f || p.z < -0.9f || std::abs(p.x) > 0.5f)
+        const glm::dvec3 p = m.positions[v];
+        if (p.y != 0.0 || p.z < -0.9 || std::abs(p.x) > 0.5 || m.normals[v].y < 0.99f)
             continue;
-        const glm::vec3 b(bent[3 * v], bent[3 * v + 1], bent[3 * v + 2]);
-        EXPECT_NEAR(glm::length(b), 1.0f, 1e-5f);
-        EXPECT_GT(b.z, 0.0f) << "floor vertices see more sky away from the wall (+z)";
-        EXPECT_GT(b.y, 0.5f);
+        const glm::dvec3 b(bent[3 * v], bent[3 * v + 1], bent[3 * v + 2]);
+        EXPECT_NEAR(glm::length(b), 1.0, 1e-5);
+        const Coefficients ex = rule_exact(turned_rule(rule, std::uint32_t(v)), glm::dvec3(0, 1, 0),
+                                           [&](const glm::dvec3& x) {
+                                               return wall_visible(p + glm::dvec3(0, 1e-5, 0), x, -1, 1, 1, -1);
+                                           });
+        const glm::dvec3 expected = glm::normalize(ex.bent);
+        const double err = glm::length(b - expected);
+        worst = std::max(worst, err);
+        EXPECT_LT(err, 1e-5) << "vertex " << v << " at (" << p.x << ", " << p.z << ")";
+        EXPECT_GT(b.z, 0.0) << "floor vertices see more sky away from the wall (+z)";
+        ++tested;
     }
+    std::printf("bent normal against the rule on the exact wall: %zu vertices, max |Δ| %.2e\n", tested, worst);
+    EXPECT_GT(tested, 50u);
+}
+
+TEST(AmbientOcclusion, BentNormalOfAHalfBlockedHemisphere) {
+    // A floor point under an infinitely high wall (the InfiniteWallLimit
+    // scene, H → ∞) sees only the quarter sphere z > 0 of its hemisphere.
+    const double W = 2000.0, H = 1000.0;
+    Mesh m;
+    m.positions = {{-W, 0, -1}, {W, 0, -1}, {W, H, -1}, {-W, H, -1}, {0, 0, 0}, {0, 0, 0.01f}, {0.01f, 0, 0}};
+    m.indices = {0, 1, 2, 0, 2, 3, 4, 5, 6};
+    compute_normals(m);
+    BakeOptions o;
+    o.ray_offset = 1e-5f;
+    bake_ambient_occlusion(m, parse_rule("lebedev:5810+rotate=7"), "embree", o);
+    const auto& bent = m.find_attribute("bent_normal")->values;
+    const glm::dvec3 b(bent[12], bent[13], bent[14]);
+    // Over {y > 0, z > 0} with y the normal: ∫ y² dω = π/3 (half of the
+    // hemisphere's 2π/3) and ∫ y z dω = ∫_0^{π/2} cos θ sin θ · sin θ dθ ·
+    // ∫_0^π sin φ dφ = (1/3)(2) = 2/3. The tilt from the normal is
+    // atan((2/3)/(π/3)) = atan(2/π) = 32.48°; a uniform weight would give 45°.
+    const double tilt_deg = std::atan2(b.z, b.y) * 180.0 / kPi;
+    std::printf("half-blocked hemisphere: bent normal tilt %.3f° (closed form %.3f°)\n", tilt_deg,
+                std::atan(2.0 / kPi) * 180.0 / kPi);
+    EXPECT_NEAR(tilt_deg, std::atan(2.0 / kPi) * 180.0 / kPi, 0.3);
+    EXPECT_NEAR(b.x, 0.0, 5e-3);
 }
 
 TEST(AmbientOcclusion, ShadingFromStoredBitsEqualsTheBake) {
@@ -390,8 +437,17 @@ TEST(AmbientOcclusion, PreviewShowsTheBakedValues) {
 
 TEST(AmbientOcclusion, BakeComputesMissingNormals) {
     Mesh m = generated(ProceduralKind::Sphere, 500);
+    Mesh reference = m;
+    compute_normals(reference);
     m.normals.clear();
     bake_ambient_occlusion(m, parse_rule("lebedev:50"));
-    EXPECT_EQ(m.normals.size(), m.vertex_count());
-    EXPECT_THROW(bake_ambient_occlusion(m, parse_rule("lebedev:50"), "cuda"), Error);
+    ASSERT_EQ(m.normals.size(), m.vertex_count());
+    for (std::size_t v = 0; v < m.vertex_count(); ++v)
+        ASSERT_EQ(m.normals[v], reference.normals[v]) << "vertex " << v;
+    // A generated sphere's normals point outwards: a sign flip would not pass.
+    for (std::size_t v = 0; v < m.vertex_count(); ++v)
+        ASSERT_GT(glm::dot(m.normals[v], glm::normalize(m.positions[v])), 0.99f) << "vertex " << v;
+    if (cuda_device_count() == 0) { // without a GPU (or CUDA) "cuda" is a clear error
+        EXPECT_THROW(bake_ambient_occlusion(m, parse_rule("lebedev:50"), "cuda"), Error);
+    }
 }

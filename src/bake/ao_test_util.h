@@ -62,10 +62,11 @@ inline double polygon_solid_angle(const glm::dvec3& p, const std::vector<glm::dv
 
 struct Coefficients {
     double ao = 0.0, shading = 0.0;
+    glm::dvec3 bent{0.0}; // Σ_k w_k (n·x_k)+ V(x_k) x_k, not normalised
 };
 
-// Σ_k w_k 4(n·x_k)+ V(x_k) and Σ_k w_k 2 H(n·x_k) V(x_k) (H: 1 above, ½ on
-// the horizon), for an exact visibility function V(x) (1 = open): the bake's
+// Σ_k w_k 4(n·x_k)+ V(x_k), Σ_k w_k 2 H(n·x_k) V(x_k) (H: 1 above, ½ on
+// the horizon) and the bent normal's sum Σ_k w_k (n·x_k)+ V(x_k) x_k, for an exact visibility function V(x) (1 = open): the bake's
 // sums (skybake/visibility.h) with the ideal shape in place of the mesh.
 template <class V>
 Coefficients rule_exact(const SphereRule& rule, const glm::dvec3& n, V&& visible) {
@@ -76,6 +77,7 @@ Coefficients rule_exact(const SphereRule& rule, const glm::dvec3& n, V&& visible
             continue;
         c.ao += 4.0 * rule.weights[k] * cn;
         c.shading += (cn > 0.0 ? 2.0 : 1.0) * rule.weights[k];
+        c.bent += rule.weights[k] * cn * rule.points[k];
     }
     return c;
 }

@@ -22,6 +22,7 @@ bool build_has_cuda() {
 #if !defined(SKYBAKE_HAS_CUDA)
 int cuda_device_count() { return 0; }
 std::string cuda_device_name() { return {}; }
+std::string cuda_device_problem() { return "this build has no CUDA support"; }
 #endif
 
 void require_cuda_device(const std::string& where) {
@@ -30,7 +31,7 @@ void require_cuda_device(const std::string& where) {
                     "/usr/local/cuda)",
                     where);
     if (cuda_device_count() == 0)
-        throw Error("no CUDA device found; use --device cpu", where);
+        throw Error("no usable CUDA device (" + cuda_device_problem() + "); use --device cpu", where);
 }
 
 Device parse_device(const std::string& name, const std::string& where) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "skybake/core.h"
+#include "core/gpu_test.h"
 
 namespace {
 __global__ void saxpy(int n, float a, const float* x, float* y) {
@@ -15,8 +16,7 @@ __global__ void saxpy(int n, float a, const float* x, float* y) {
 TEST(CudaDevice, BuildReportsCuda) { EXPECT_TRUE(skybake::build_has_cuda()); }
 
 TEST(CudaDevice, KernelRuns) {
-    if (skybake::cuda_device_count() == 0)
-        GTEST_SKIP() << "no CUDA device";
+    SKYBAKE_SKIP_WITHOUT_GPU();
     const int n = 1000;
     std::vector<float> x(n), y(n);
     for (int i = 0; i < n; ++i) {

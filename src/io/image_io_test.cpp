@@ -68,6 +68,24 @@ TEST(ToneMap, SrgbTransferInverts) {
     for (float v = 0.0f; v <= 1.0f; v += 1.0f / 64.0f)
         EXPECT_NEAR(srgb_to_linear(linear_to_srgb(v)), v, 1e-6f);
     EXPECT_NEAR(linear_to_srgb(0.0031308f), 0.04045f, 1e-5f); // the two branches meet
+    // IEC 61966-2-1, each branch pinned: 1.055 v^(1/2.4) − 0.055 and 12.92 v.
+    EXPECT_NEAR(linear_to_srgb(0.5f), 0.735357f, 2e-6f);
+    EXPECT_NEAR(linear_to_srgb(0.18f), 0.461356f, 2e-6f);
+    EXPECT_NEAR(linear_to_srgb(0.001f), 0.01292f, 1e-7f);
+    EXPECT_NEAR(srgb_to_linear(0.5f), 0.214041f, 2e-6f);
+    EXPECT_NEAR(srgb_to_linear(0.02f), 0.02f / 12.92f, 1e-8f);
+    EXPECT_NEAR(linear_to_srgb(2.0f), 1.0f, 1e-6f); // clamped to 1 first (1.055 − 0.055 in float)
+}
+
+TEST(ToneMap, AcesCurveAtKnownPoints) {
+    // Narkowicz 2015: x(2.51x + 0.03) / (x(2.43x + 0.59) + 0.14).
+    EXPECT_NEAR(tone_map_value(1.0f, {0.0f, ToneCurve::Aces}), 2.54f / 3.16f, 1e-6f); // 0.803797
+    EXPECT_NEAR(tone_map_value(0.18f, {0.0f, ToneCurve::Aces}), 0.266899f, 2e-6f);  // middle grey
+    EXPECT_NEAR(tone_map_value(0.5f, {0.0f, ToneCurve::Aces}), 0.616307f, 2e-6f);
+    EXPECT_NEAR(tone_map_value(0.25f, {1.0f, ToneCurve::Aces}), 0.616307f, 2e-6f); // +1 EV before the curve
+    EXPECT_NEAR(tone_map_value(4.0f, {0.0f, ToneCurve::Aces}), 0.973417f, 2e-6f);
+    EXPECT_EQ(tone_map_value(20.0f, {0.0f, ToneCurve::Aces}), 1.0f); // 1.0210, clamped
+    EXPECT_NEAR(tone_map_value(1e-3f, {0.0f, ToneCurve::Aces}), 2.312358e-4f, 1e-9f);
 }
 
 TEST(ToneMap, CurvesAreMonotonicAndBounded) {

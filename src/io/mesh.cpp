@@ -141,16 +141,19 @@ Mesh finish_import(RawImport raw, const std::string& where, const ImportLimits& 
     if (mesh.indices.empty())
         throw Error(fmt::format("all {} triangles are degenerate (zero area)", rep.degenerate_triangles), where);
 
-    // Normals: keep the file's when every one is finite and non-zero.
+    // Normals: keep the file's when every one is finite and non-zero. Those of
+    // unit length to float precision are kept bit for bit (so that a save and
+    // load round trip is exact); the others are normalised.
     bool usable = mesh.normals.size() == mesh.vertex_count();
     if (usable)
         for (auto& n : mesh.normals) {
-            const float len = glm::length(n);
-            if (!std::isfinite(len) || len < 1e-12f) {
+            const double len = glm::length(glm::dvec3(n));
+            if (!std::isfinite(len) || len < 1e-12) {
                 usable = false;
                 break;
             }
-            n /= len;
+            if (std::abs(len - 1.0) > 0x1.0p-22)
+                n = glm::vec3(glm::dvec3(n) / len);
         }
     rep.normals_present = usable;
     if (!usable)

@@ -1,7 +1,12 @@
 // Tests of the shader/C export: the exported C and CUDA (compiled as C++)
 // agree with the library's inference to 1e-6 relative; the GLSL compiles with
 // glslangValidator in vertex and fragment shaders, the HLSL in its HLSL mode.
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <regex>
+#include <set>
+#include <utility>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -140,9 +145,10 @@ TEST(NeuralExport, GlslCompilesInVertexAndFragmentShaders) {
         for (const char* stage : {"sky.vert", "sky.frag"}) {
             const std::string cmd = fmt::format("glslangValidator {} > {} 2>&1", (dir / stage).string(),
                                                 (dir / "log.txt").string());
-            std::ifstream log_file(dir / "log.txt");
-            EXPECT_EQ(std::system(cmd.c_str()), 0)
-                << top << " " << stage << ": " << std::string(std::istreambuf_iterator<char>(log_file), {});
+            const int rc = std::system(cmd.c_str());
+            std::ifstream log_file(dir / "log.txt"); // opened after the run, so that it holds this run's log
+            EXPECT_EQ(rc, 0) << top << " " << stage << ": "
+                             << std::string(std::istreambuf_iterator<char>(log_file), {});
         }
     }
 }
@@ -159,6 +165,66 @@ TEST(NeuralExport, HlslCompiles) {
     const int rc = std::system(cmd.c_str());
     std::ifstream log_file(dir / "log.txt");
     EXPECT_EQ(rc, 0) << std::string(std::istreambuf_iterator<char>(log_file), {});
+}
+
+namespace {
+
+// Every float literal of an exported source, in order (a literal always has a
+// '.' or an exponent; identifiers such as s0_1_2 and indices are skipped).
+std::vector<float> float_literals(const std::string& src) {
+    static const std::regex re(R"(([0-9]+\.[0-9]*(?:e[-+]?[0-9]+)?|[0-9]+e[-+]?[0-9]+)f?)");
+    std::vector<float> out;
+    for (auto it = std::sregex_iterator(src.begin(), src.end(), re); it != std::sregex_iterator(); ++it) {
+        const auto pos = std::size_t(it->position(0));
+        if (pos > 0) {
+            const unsigned char c = static_cast<unsigned char>(src[pos - 1]);
+            if (std::isalnum(c) || c == '_' || c == '.')
+                continue;
+        }
+        out.push_back(std::strtof(it->str(1).c_str(), nullptr));
+    }
+    return out;
+}
+
+// The literals of the layers, in order, and the set of the decoding's constants.
+std::pair<std::vector<float>, std::set<float>> split_at_decoding(const std::string& src) {
+    const std::size_t cut = src.find("// decoding");
+    EXPECT_NE(cut, std::string::npos);
+    const std::vector<float> tail = float_literals(src.substr(cut));
+    return {float_literals(src.substr(0, cut)), std::set<float>(tail.begin(), tail.end())};
+}
+
+} // namespace
+
+TEST(NeuralExport, ShaderLiteralsEqualTheCExports) {
+    // The C export is checked against the library to 1e-6 above; the GLSL and
+    // HLSL only compile. Their numbers must be the C export's, bit for bit and
+    // in the same order, so a rounding or a dropped weight in one dialect fails.
+    for (const char* top : {"paper", "independent:16x16", "shared:16x8"})
+        for (BrightnessEncoding b : {BrightnessEncoding::Log, BrightnessEncoding::Seed}) {
+            const NeuralSky net = make_net(top, b);
+            const std::vector<float> c = float_literals(export_neural_sky(net, ExportLanguage::C));
+            ASSERT_GE(c.size(), std::size_t(net.topology.weight_count())) << top;
+            // The weights appear among them, each as the float it is.
+            std::vector<float> sorted_c = c, sorted_w = net.weights;
+            for (float& w : sorted_w)
+                w = std::abs(w);
+            std::sort(sorted_c.begin(), sorted_c.end());
+            std::sort(sorted_w.begin(), sorted_w.end());
+            EXPECT_TRUE(std::includes(sorted_c.begin(), sorted_c.end(), sorted_w.begin(), sorted_w.end())) << top;
+            const auto [c_net, c_decode] = split_at_decoding(export_neural_sky(net, ExportLanguage::C));
+            for (ExportLanguage lang : {ExportLanguage::Glsl, ExportLanguage::Hlsl, ExportLanguage::Cuda}) {
+                const auto [o_net, o_decode] = split_at_decoding(export_neural_sky(net, lang));
+                // The layers: the same literals in the same order.
+                ASSERT_EQ(o_net.size(), c_net.size()) << top << " language " << int(lang);
+                for (std::size_t i = 0; i < c_net.size(); ++i)
+                    ASSERT_EQ(std::bit_cast<std::uint32_t>(o_net[i]), std::bit_cast<std::uint32_t>(c_net[i]))
+                        << top << " language " << int(lang) << " literal " << i;
+                // The decoding: a vector max in shaders, per-channel tests in C,
+                // so the same constants, not the same count.
+                EXPECT_EQ(o_decode, c_decode) << top << " language " << int(lang);
+            }
+        }
 }
 
 TEST(NeuralExport, RejectsBadNames) {

@@ -9,6 +9,7 @@
 #include "neural/mlp_hd.h"
 #include "skybake/core.h"
 #include "skybake/neural.h"
+#include "core/gpu_test.h"
 
 namespace {
 
@@ -23,8 +24,7 @@ __global__ void sky_kernel(skybake::neural::MlpHD m, int n, const float4* in, fl
 } // namespace
 
 TEST(NeuralGpu, ForwardPassMatchesTheCpu) {
-    if (skybake::cuda_device_count() == 0)
-        GTEST_SKIP() << "no CUDA device";
+    SKYBAKE_SKIP_WITHOUT_GPU();
     for (const char* topology : {"paper", "shared:32x16"}) {
         skybake::NeuralSky net;
         net.topology = skybake::parse_topology(topology);

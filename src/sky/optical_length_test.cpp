@@ -71,9 +71,12 @@ TEST(OpticalLengthExact, HorizonMatchesChapmanFunction) {
     EXPECT_NEAR(optical_length_exact(gas, 0, 0.0, 0.0) / 8.0, 35.355, 2e-3);
     const Atmosphere aerosol = single_exponential(6360.0, 1.2, 1.2 * 60.0);
     EXPECT_NEAR(optical_length_exact(aerosol, 0, 0.0, 0.0) / 1.2, 91.249, 2e-3);
-    // The asymptotic form sqrt(πx/2)(1 + 1/(8x)).
+    // The asymptotic form: Ch(x, 90°) = x eˣ K₁(x) ≈ sqrt(πx/2)(1 + 3/(8x)),
+    // 35.3548 at x = 795 (the next term, −15/(128x²), is 2e-7 relative).
     const double x = 6360.0 / 8.0;
-    EXPECT_NEAR(optical_length_exact(gas, 0, 0.0, 0.0) / 8.0, std::sqrt(M_PI * x / 2) * (1 + 1 / (8 * x)), 0.04);
+    const double chapman = std::sqrt(M_PI * x / 2) * (1 + 3 / (8 * x));
+    EXPECT_NEAR(chapman, 35.3548, 1e-4);
+    EXPECT_NEAR(optical_length_exact(gas, 0, 0.0, 0.0) / 8.0, chapman, 1e-3);
 }
 
 TEST(OpticalLengthExact, UniformShellIsTheChordLength) {

@@ -9,6 +9,7 @@
 #include "skybake/core.h"
 #include "skybake/error.h"
 #include "skybake/sky.h"
+#include "core/gpu_test.h"
 
 using namespace skybake;
 
@@ -36,8 +37,7 @@ TEST(SkyCuda, WithoutADeviceTheErrorIsClear) {
 }
 
 TEST(SkyCuda, SamplesMatchTheCpu) {
-    if (cuda_device_count() == 0)
-        GTEST_SKIP() << "no CUDA device";
+    SKYBAKE_SKIP_WITHOUT_GPU();
     for (const char* preset : {"earth", "paper", "paper-dense"}) {
         SCOPED_TRACE(preset);
         const SkyModel model(atmosphere_preset(preset));
@@ -56,8 +56,7 @@ TEST(SkyCuda, SamplesMatchTheCpu) {
 }
 
 TEST(SkyCuda, RenderMatchesTheCpu) {
-    if (cuda_device_count() == 0)
-        GTEST_SKIP() << "no CUDA device";
+    SKYBAKE_SKIP_WITHOUT_GPU();
     const SkyModel model(atmosphere_preset("earth"));
     for (SkyView view : {SkyView::Fisheye, SkyView::Panorama, SkyView::Camera}) {
         SkyRenderSettings s;

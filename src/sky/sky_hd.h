@@ -223,6 +223,18 @@ SKYBAKE_HD_INLINE bool enter_atmosphere(const AtmosphereHD& a, ObserverHD& o) {
 // steps it is ~10x more accurate than uniform steps at the same cost.
 enum : int { kStepsGraded = 0, kStepsUniform = 1 };
 
+// cos α_v and cos θ_v at distance v (km) along the view ray, where the radius
+// is 1/inv_rv: the projections of p = r0 U0 + v V on V and on L, clamped to
+// [−1, 1] against rounding.
+struct StepCosines {
+    float view_zenith; // cos α_v
+    float sun_zenith;  // cos θ_v
+};
+SKYBAKE_HD_INLINE StepCosines step_cosines(const ObserverHD& o, float v, float inv_rv) {
+    return {fminf(fmaxf((o.r * o.cv + v) * inv_rv, -1.0f), 1.0f),
+            fminf(fmaxf((o.r * o.cs + v * o.cvs) * inv_rv, -1.0f), 1.0f)};
+}
+
 struct SumState {
     glm::vec3 scatter[kMaxComponents];
     float l_obs[kMaxComponents];
@@ -236,8 +248,8 @@ SKYBAKE_HD_INLINE void sum_point(const AtmosphereHD& a, const ObserverHD& o, con
     const float rv = sqrtf(a.R0 * a.R0 + d2);
     const float hv = d2 / (rv + a.R0);
     const float inv_r = 1.0f / rv;
-    const float cav = fminf(fmaxf((o.r * o.cv + v) * inv_r, -1.0f), 1.0f);
-    const float cth = fminf(fmaxf((o.r * o.cs + v * o.cvs) * inv_r, -1.0f), 1.0f);
+    const StepCosines c_v = step_cosines(o, v, inv_r);
+    const float cav = c_v.view_zenith, cth = c_v.sun_zenith;
     if (in_planet_shadow(rv, cth, a.R0))
         return;
     glm::vec3 tau(0.0f), weight(0.0f);

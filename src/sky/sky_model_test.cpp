@@ -22,6 +22,19 @@ double rel(const glm::dvec3& a, const glm::dvec3& b) {
     return std::max({d.x, d.y, d.z}) / m;
 }
 
+// p(μ = 1) of each phase function, written out from its formula (not through
+// the library), so that the zenith closed form below is independent of it.
+double forward_phase(PhaseFunction p, double g) {
+    switch (p) {
+    case PhaseFunction::None: return 0.0;
+    case PhaseFunction::Rayleigh: return 3.0 / (8.0 * M_PI);
+    case PhaseFunction::HenyeyGreenstein: return (1.0 + g) / (4.0 * M_PI * (1.0 - g) * (1.0 - g));
+    case PhaseFunction::CornetteShanks: return 6.0 * (1.0 + g) / (8.0 * M_PI * (2.0 + g * g) * (1.0 - g) * (1.0 - g));
+    case PhaseFunction::SeedMie: return (1.0 + g) / (16.0 * M_PI * (1.0 - g) * (1.0 - g));
+    }
+    return -1.0;
+}
+
 // Single-scattered zenith radiance with the sun at the zenith (REFERENCE.md):
 // both paths run straight up, so the attenuation is the whole column's,
 // L/E = exp(−τ) Σ_k τ_s,k p_k(1), with τ_s,k = β_s,k ∫ρ_k dh.
@@ -35,7 +48,7 @@ glm::dvec3 zenith_closed_form(const Atmosphere& a) {
         else if (c.profile == DensityProfile::Tent)
             column = c.tent_half_width_km; // the whole tent lies below the top
         tau += c.extinction_per_km * column;
-        sum += c.scattering_per_km * column * phase_function(c.phase, c.phase_g, 1.0);
+        sum += c.scattering_per_km * column * forward_phase(c.phase, c.phase_g);
     }
     return glm::exp(-tau) * sum;
 }
@@ -60,6 +73,52 @@ TEST(PhaseFunctions, NormalisedOverTheSphere) {
         EXPECT_NEAR(integral(PhaseFunction::CornetteShanks, g, 0), 1.0, 1e-4) << g;
         EXPECT_NEAR(integral(PhaseFunction::SeedMie, g, 0), 0.25, 1e-4) << g;
     }
+}
+
+TEST(PhaseFunctions, PinnedToTheirFormulasForwardSidewaysAndBack) {
+    // p(1), p(0), p(−1) from each formula evaluated by hand (REFERENCE.md).
+    const double pi = M_PI;
+    EXPECT_NEAR(phase_function(PhaseFunction::Rayleigh, 0.0, 1.0), 3.0 / (8.0 * pi), 1e-15);
+    EXPECT_NEAR(phase_function(PhaseFunction::Rayleigh, 0.0, 0.0), 3.0 / (16.0 * pi), 1e-15);
+    EXPECT_NEAR(phase_function(PhaseFunction::Rayleigh, 0.0, -1.0), 3.0 / (8.0 * pi), 1e-15);
+    for (double g : {0.0, 0.3, 0.76, -0.5}) {
+        const double hg_f = (1 + g) / (4 * pi * (1 - g) * (1 - g));
+        const double hg_b = (1 - g) / (4 * pi * (1 + g) * (1 + g));
+        const double hg_s = (1 - g * g) / (4 * pi * std::pow(1 + g * g, 1.5));
+        EXPECT_NEAR(phase_function(PhaseFunction::HenyeyGreenstein, g, 1.0), hg_f, 1e-12 * hg_f) << g;
+        EXPECT_NEAR(phase_function(PhaseFunction::HenyeyGreenstein, g, -1.0), hg_b, 1e-12 * hg_b) << g;
+        EXPECT_NEAR(phase_function(PhaseFunction::HenyeyGreenstein, g, 0.0), hg_s, 1e-12 * hg_s) << g;
+        // Cornette–Shanks: 3/(2(2 + g²)) (1 + μ²) times HG.
+        const double cs = 3.0 / (2.0 * (2.0 + g * g));
+        EXPECT_NEAR(phase_function(PhaseFunction::CornetteShanks, g, 1.0), 2 * cs * hg_f, 1e-12 * hg_f) << g;
+        EXPECT_NEAR(phase_function(PhaseFunction::CornetteShanks, g, -1.0), 2 * cs * hg_b, 1e-12 * hg_b) << g;
+        EXPECT_NEAR(phase_function(PhaseFunction::CornetteShanks, g, 0.0), cs * hg_s, 1e-12 * hg_s) << g;
+        // The seed's printed Mie: HG / 4.
+        EXPECT_NEAR(phase_function(PhaseFunction::SeedMie, g, 1.0), hg_f / 4, 1e-12 * hg_f) << g;
+        EXPECT_NEAR(phase_function(PhaseFunction::SeedMie, g, -1.0), hg_b / 4, 1e-12 * hg_f) << g;
+        EXPECT_NEAR(phase_function(PhaseFunction::SeedMie, g, 0.0), hg_s / 4, 1e-12 * hg_f) << g;
+        EXPECT_EQ(phase_function(PhaseFunction::None, g, 0.5), 0.0);
+    }
+    // Forward scattering dominates for g > 0: p(1)/p(−1) = ((1 + g)/(1 − g))³.
+    EXPECT_NEAR(phase_function(PhaseFunction::HenyeyGreenstein, 0.5, 1.0) /
+                    phase_function(PhaseFunction::HenyeyGreenstein, 0.5, -1.0),
+                27.0, 1e-10);
+}
+
+TEST(PhaseFunctions, Moments) {
+    // Rayleigh: 2π ∫ p μ² dμ = (3/8)(2/3 + 2/5) = 2/5 (isotropic would give 1/3).
+    // Gauss–Legendre with 8 nodes integrates these polynomials exactly.
+    const double x[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267, 0.9602898564975363};
+    const double w[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
+    double m0 = 0.0, m2 = 0.0;
+    for (int i = 0; i < 4; ++i)
+        for (double mu : {x[i], -x[i]}) {
+            const double p = phase_function(PhaseFunction::Rayleigh, 0.0, mu);
+            m0 += 2.0 * M_PI * w[i] * p;
+            m2 += 2.0 * M_PI * w[i] * p * mu * mu;
+        }
+    EXPECT_NEAR(m0, 1.0, 1e-12);
+    EXPECT_NEAR(m2, 0.4, 1e-12);
 }
 
 TEST(PhaseFunctions, SharedFloatCodeMatchesDouble) {
@@ -100,21 +159,26 @@ TEST(SampleSpace, DrawnSamplesAreValidAndDeterministic) {
     }
 }
 
-TEST(SeedSum, VectorFormEqualsTheSeedsDihedralFormula) {
+TEST(SeedSum, StepCosinesEqualTheSeedsDihedralFormula) {
     // Seed: cos θ_v = cos α_v cos β0 + sin α_v sin β0 cos Λ with
-    // cos Λ = (cos θ0 − cos α0 cos β0)/(sin α0 sin β0). sky_hd.h uses
-    // (r0 cos θ0 + v cos β0)/r_v; they must agree.
+    // cos Λ = (cos θ0 − cos α0 cos β0)/(sin α0 sin β0), and r0 sin α0 =
+    // r_v sin α_v. The library's per-step cosines (sky::step_cosines, the ones
+    // the marching sum uses) must agree, in double here against float there.
     const double r0 = 6372.0;
     for (double ca : {0.9, 0.3, -0.2})
         for (double cb : {0.8, -0.4})
             for (double cosl : {0.7, -0.5}) {
                 const double sa = std::sqrt(1 - ca * ca), sb = std::sqrt(1 - cb * cb);
                 const double ct0 = ca * cb + sa * sb * cosl;
+                const sky::ObserverHD o{float(r0), float(r0 - 6371.0), float(ca), float(cb), float(ct0)};
                 for (double v : {1.0, 50.0, 400.0}) {
                     const double rv = std::sqrt(r0 * r0 + v * v + 2 * r0 * v * ca);
-                    const double cav = (r0 * ca + v) / rv, sav = r0 * sa / rv;
+                    const double sav = r0 * sa / rv;                         // r0 sin α0 = r_v sin α_v
+                    const double cav = std::sqrt(1 - sav * sav) * (r0 * ca + v >= 0 ? 1 : -1);
                     const double seed = cav * cb + sav * sb * cosl;
-                    EXPECT_NEAR((r0 * ct0 + v * cb) / rv, seed, 1e-12);
+                    const sky::StepCosines c = sky::step_cosines(o, float(v), float(1.0 / rv));
+                    EXPECT_NEAR(c.view_zenith, cav, 2e-6) << ca << " " << cb << " " << cosl << " " << v;
+                    EXPECT_NEAR(c.sun_zenith, seed, 2e-6) << ca << " " << cb << " " << cosl << " " << v;
                 }
             }
 }
@@ -167,20 +231,37 @@ TEST(SkyModel, SumConvergesAsStepsDouble) {
 }
 
 TEST(SkyModel, TablesAgreeWithExactOnRandomSamples) {
-    // docs/sky.md: median and 90th percentile of the relative error.
+    // docs/sky.md: the table path against the exact reference on 600 random
+    // lit samples, by class: looking up, looking down (below the horizon) and
+    // twilight (sun less than ~6° above the horizon). p90 and max per class,
+    // each bounded at about 1.3× the figure measured on this preset.
     Atmosphere a = atmosphere_preset("paper-dense");
     const SkyModel model(a, SkyModelOptions{{256, 128}, 64});
-    const auto samples = draw_sky_samples(40, 3);
-    std::vector<double> errs;
+    const auto samples = draw_sky_samples(1500, 3);
+    std::vector<double> errs[3];
+    const char* names[3] = {"up", "down", "twilight"};
     for (const SkySample& s : samples) {
         const glm::dvec3 e = model.radiance(s, SkyMethod::Exact);
         if (std::max({e.x, e.y, e.z}) < 1e-6)
             continue; // night
-        errs.push_back(rel(model.radiance(s, SkyMethod::Tables), e));
+        const int cls = s.cos_sun_zenith < 0.1f ? 2 : (s.cos_view_zenith >= 0.0f ? 0 : 1);
+        errs[cls].push_back(rel(model.radiance(s, SkyMethod::Tables), e));
     }
-    ASSERT_GT(errs.size(), 10u);
-    std::sort(errs.begin(), errs.end());
-    EXPECT_LT(errs[errs.size() / 2], 0.03);
+    const double p90_bound[3] = {6.8e-3, 1.0e-2, 4.1e-2};
+    const double max_bound[3] = {1.1e-2, 2.9e-2, 7.9e-2};
+    std::size_t total = 0;
+    for (int c = 0; c < 3; ++c) {
+        auto& e = errs[c];
+        ASSERT_GE(e.size(), 100u) << names[c];
+        total += e.size();
+        std::sort(e.begin(), e.end());
+        const double p90 = e[e.size() * 9 / 10], worst = e.back();
+        std::printf("tables vs exact, %s: %zu samples, median %.2e p90 %.2e max %.2e\n", names[c], e.size(),
+                    e[e.size() / 2], p90, worst);
+        EXPECT_LT(p90, p90_bound[c]) << names[c];
+        EXPECT_LT(worst, max_bound[c]) << names[c];
+    }
+    EXPECT_GE(total, 500u);
 }
 
 TEST(SkyModel, ObserverInSpaceSeesTheSameAsAtTheTop) {

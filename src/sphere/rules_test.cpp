@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <vector>
 
 #include "skybake/error.h"
 #include "skybake/sphere.h"
@@ -174,6 +176,33 @@ TEST(RuleSpec, BadSpecsSayWhatIsWrong) {
     EXPECT_NE(message("phong:a=-1,n=3").find("exponent"), std::string::npos);
     EXPECT_NE(message("phong:a=4").find("both"), std::string::npos);
     EXPECT_NE(message("fibonacci:10+spin").find("+rotate"), std::string::npos);
+}
+
+TEST(VertexRotation, RotationAnglesFollowTheHaarDensity) {
+    // A uniform rotation's angle ω has density (1 − cos ω)/π on [0, π], CDF
+    // (ω − sin ω)/π, and E[cos ω] = −1/2 (so E[trace] = 0). Rotations that only
+    // send ẑ to uniform directions (a random axis with a uniform angle, say)
+    // pass the ẑ test below but not this one.
+    const int n = 20000;
+    std::vector<double> omega(n);
+    double mean_cos = 0.0;
+    for (int v = 0; v < n; ++v) {
+        const glm::dmat3 r = vertex_rotation(std::uint32_t(v), 42);
+        const double c = std::clamp((r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0, -1.0, 1.0);
+        omega[std::size_t(v)] = std::acos(c);
+        mean_cos += c / n;
+    }
+    std::sort(omega.begin(), omega.end());
+    double ks = 0.0; // Kolmogorov–Smirnov distance to the CDF
+    for (int i = 0; i < n; ++i) {
+        const double w = omega[std::size_t(i)], cdf = (w - std::sin(w)) / M_PI;
+        ks = std::max({ks, std::abs(cdf - double(i) / n), std::abs(cdf - double(i + 1) / n)});
+    }
+    std::printf("rotation angles: KS distance %.4f (1%% critical value %.4f), E[cos ω] %.4f\n", ks, 1.63 / std::sqrt(n),
+                mean_cos);
+    EXPECT_LT(ks, 1.63 / std::sqrt(double(n)));
+    // Var[cos ω] = E[cos² ω] − 1/4 = 1/2 − 1/4.
+    EXPECT_NEAR(mean_cos, -0.5, 5 * std::sqrt(0.25 / n));
 }
 
 TEST(VertexRotation, ProperOrthogonalDeterministicAndUniform) {

@@ -226,13 +226,14 @@ TEST(ShEnvmap, ConstantAndSmoothMaps) {
     for (std::size_t i = 1; i < c.size(); ++i)
         EXPECT_NEAR(glm::length(c[i]), 0.0, 1e-12);
 
-    // f = 0.5 + 0.3 z + 0.2 x sampled at pixel centres; bilinear error O(h²).
+    // f = 0.5 + 0.3 z + 0.2 x + 0.1 y sampled at pixel centres; bilinear error
+    // O(h²). The y term pins the sense of φ: a reversed azimuth gives −0.1.
     Image smooth(512, 256);
     for (int j = 0; j < smooth.height; ++j)
         for (int i = 0; i < smooth.width; ++i) {
             const double phi = 2 * kPi * (i + 0.5) / smooth.width, theta = kPi * (j + 0.5) / smooth.height;
             const glm::dvec3 d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
-            const float v = float(0.5 + 0.3 * d.z + 0.2 * d.x);
+            const float v = float(0.5 + 0.3 * d.z + 0.2 * d.x + 0.1 * d.y);
             float* p = smooth.pixel(i, j);
             p[0] = p[1] = p[2] = v;
             EXPECT_NEAR(sample_equirect(smooth, d).x, v, 1e-7);
@@ -242,6 +243,7 @@ TEST(ShEnvmap, ConstantAndSmoothMaps) {
     EXPECT_NEAR(s[std::size_t(sh_index(0, 0))].y, 0.5 * std::sqrt(4 * kPi), 1e-3);
     EXPECT_NEAR(s[std::size_t(sh_index(1, 0))].y, 0.3 * c1, 1e-3);
     EXPECT_NEAR(s[std::size_t(sh_index(1, 1))].y, 0.2 * c1, 1e-3);
-    EXPECT_NEAR(s[std::size_t(sh_index(1, -1))].y, 0.0, 1e-4);
+    EXPECT_NEAR(s[std::size_t(sh_index(1, -1))].y, 0.1 * c1, 1e-3);
+    EXPECT_NEAR(s[std::size_t(sh_index(2, 0))].y, 0.0, 1e-4);
     EXPECT_THROW(sh_project_equirect(Image(), 2, rule), Error);
 }

@@ -10,6 +10,7 @@
 #include "skybake/sphere.h"
 #include "sphere/random_rotation.h"
 #include "sphere/sh_eval.h"
+#include "core/gpu_test.h"
 
 namespace {
 
@@ -30,8 +31,7 @@ __global__ void eval_kernel(int n, const float3* dirs, float* sh, float* rot) {
 } // namespace
 
 TEST(SphereGpu, ShAndRotationsMatchTheCpu) {
-    if (skybake::cuda_device_count() == 0)
-        GTEST_SKIP() << "no CUDA device";
+    SKYBAKE_SKIP_WITHOUT_GPU();
     const int n = 1024;
     const skybake::SphereRule rule = skybake::marsaglia_rule(n, 5);
     std::vector<float3> dirs(n);

@@ -288,7 +288,7 @@ struct CudaBackend::Impl {
 
 CudaBackend::CudaBackend() : impl_(std::make_unique<Impl>()) {
     if (cuda_device_count() == 0)
-        throw Error("no CUDA device found; use --backend embree", "--backend cuda");
+        throw Error("no usable CUDA device (" + cuda_device_problem() + "); use --backend embree", "--backend cuda");
     SKYBAKE_CUDA_CHECK(cudaSetDevice(0));
     impl_->device = cuda_device_name();
 }

@@ -9,6 +9,7 @@
 
 #include "cli_runner.h"
 #include "skybake/core.h"
+#include "core/gpu_test.h"
 
 using skybake::test::run_cli;
 using skybake::test::temp_dir;
@@ -65,8 +66,7 @@ TEST(GpuSkyCli, UnknownDeviceIsAnError) {
 }
 
 TEST(GpuSkyCli, CudaAgreesWithCpu) {
-    if (skybake::cuda_device_count() == 0)
-        GTEST_SKIP() << "no CUDA device";
+    SKYBAKE_SKIP_WITHOUT_GPU();
     const std::string dir = temp_dir("gpu-cli-agree");
     const std::string in = write_input(dir);
     ASSERT_EQ(run_cli({"sky", "eval", "--preset", "earth", "--input", in, "--output", dir + "/cpu.csv"}).exit_code, 0);
