@@ -112,8 +112,9 @@ TEST(AmbientOcclusion, BowlIsOneHalfInside) {
         // Tessellation (3000 triangles, chords up to ~0.06) and ray offsets.
         EXPECT_LT(vs_rule.rms(), 3e-3) << spec;
         EXPECT_LT(vs_rule.worst, 2e-2) << spec;
-        // Closed form, within the rule's own error plus the tessellation term.
-        EXPECT_LT(vs_closed.worst, rule_error.worst + vs_rule.worst) << spec;
+        // Closed form: the rule's own error dominates (3.4e-2 worst unturned,
+        // 2.9e-2 turned, measured); bounded at about 1.3× that.
+        EXPECT_LT(vs_closed.worst, rule.rotate_per_vertex ? 3.8e-2 : 4.5e-2) << spec;
         EXPECT_LT(vs_closed.rms(), 1e-2) << spec;
     }
     // A at the bottom of the bowl: the opening (unit disk at distance 1) covers
@@ -167,8 +168,10 @@ TEST(AmbientOcclusion, FiniteWallMatchesPolygonFormFactor) {
         // differs by the ray offset near the foot of the wall (one direction).
         EXPECT_LT(vs_rule.worst, rule.rotate_per_vertex ? 4e-3 : 3e-2) << spec;
         EXPECT_LT(vs_rule.rms(), rule.rotate_per_vertex ? 4e-4 : 6e-3) << spec;
-        EXPECT_LT(ao_closed.worst, rule_ao.worst + vs_rule.worst + 1e-6) << spec;
-        EXPECT_LT(a_closed.worst, rule_a.worst + vs_rule.worst + 1e-6) << spec;
+        // Against the closed forms (measured worst: AO 3.1e-2 unturned, 1.4e-2
+        // turned; A 2.6e-2 and 1.4e-2), bounded at about 1.3× those.
+        EXPECT_LT(ao_closed.worst, rule.rotate_per_vertex ? 1.9e-2 : 4.1e-2) << spec;
+        EXPECT_LT(a_closed.worst, rule.rotate_per_vertex ? 1.9e-2 : 3.5e-2) << spec;
         EXPECT_LT(ao_closed.rms(), 1e-2) << spec;
         EXPECT_LT(a_closed.rms(), 1e-2) << spec;
     }

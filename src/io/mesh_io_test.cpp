@@ -1,6 +1,10 @@
 // Mesh import and export: round trips, the broken-file corpus, hostile input.
 // Labelled "io": these also run under AddressSanitizer + UBSan (make test-sanitize).
 #include <bit>
+#include <chrono>
+#include <csignal>
+#include <stdexcept>
+#include <thread>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -11,6 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "skybake/error.h"
+#include "io/mesh_internal.h"
 #include "skybake/mesh.h"
 
 using namespace skybake;
@@ -426,14 +431,103 @@ TEST(HostileInput, IsolatedAndInProcessParsesAgree) {
     EXPECT_EQ(ra.source_meshes, rb.source_meshes);
 }
 
+namespace {
+// The message of the Error that f throws, or "no error".
+template <class F>
+std::string error_of(F&& f) {
+    try {
+        f();
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+        return e.what();
+    }
+    return "no error";
+}
+} // namespace
+
 TEST(HostileInput, LimitsAreEnforced) {
-    ImportLimits lim;
-    lim.max_triangles = 10;
     const Mesh big = generate_mesh({ProceduralKind::Sphere, 500, 1});
-    const fs::path p = temp("limits.ply");
-    save_mesh(p, big);
-    EXPECT_THROW(load_mesh(p, nullptr, lim), Error);
-    lim = {};
-    lim.max_file_bytes = 100;
-    EXPECT_THROW(load_mesh(p, nullptr, lim), Error);
+    for (const char* ext : {"ply", "glb", "obj"}) {
+        SCOPED_TRACE(ext);
+        const fs::path p = temp(std::string("limits.") + ext);
+        if (std::string(ext) == "obj") { // through Assimp (no OBJ writer here)
+            std::ofstream f(p);
+            for (const auto& v : big.positions)
+                f << "v " << v.x << ' ' << v.y << ' ' << v.z << '\n';
+            for (std::size_t t = 0; t < big.indices.size(); t += 3)
+                f << "f " << big.indices[t] + 1 << ' ' << big.indices[t + 1] + 1 << ' ' << big.indices[t + 2] + 1 << '\n';
+        } else {
+            save_mesh(p, big);
+        }
+        ASSERT_EQ(load_mesh(p).triangle_count(), 500u);
+        ImportLimits lim;
+        lim.max_triangles = 499;
+        EXPECT_NE(error_of([&] { load_mesh(p, nullptr, lim); }).find("500 triangles, over the limit of 499"),
+                  std::string::npos);
+        lim.max_triangles = 500; // the limit itself is allowed
+        EXPECT_EQ(load_mesh(p, nullptr, lim).triangle_count(), 500u);
+        lim = {};
+        lim.max_vertices = 10;
+        EXPECT_NE(error_of([&] { load_mesh(p, nullptr, lim); }).find("over the limit of 10"), std::string::npos);
+        lim = {};
+        lim.max_file_bytes = 100;
+        EXPECT_NE(error_of([&] { load_mesh(p, nullptr, lim); }), "no error");
+    }
+}
+
+TEST(HostileInput, AParserThatHangsBecomesAnError) {
+    // The parse runs in a child process with an alarm (ImportLimits::parser_timeout_s).
+    ImportLimits lim;
+    lim.parser_timeout_s = 1;
+    const auto t0 = std::chrono::steady_clock::now();
+    try {
+        io::run_isolated(
+            []() -> io::RawImport {
+                for (;;)
+                    std::this_thread::sleep_for(std::chrono::seconds(1));
+            },
+            "hang.obj", lim);
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("took longer than 1 s"), std::string::npos) << e.what();
+        EXPECT_EQ(e.where(), "hang.obj");
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    EXPECT_LT(seconds, 30.0) << "the alarm did not stop the parser";
+}
+
+TEST(HostileInput, AParserThatCrashesOrThrowsBecomesAnError) {
+    const ImportLimits lim;
+    EXPECT_NE(error_of([&] {
+                  io::run_isolated([]() -> io::RawImport { std::raise(SIGSEGV); return {}; }, "crash.obj", lim);
+              }).find("segmentation fault"),
+              std::string::npos);
+    EXPECT_NE(error_of([&] {
+                  io::run_isolated([]() -> io::RawImport { throw Error("bad header"); }, "x.obj", lim);
+              }).find("bad header"),
+              std::string::npos);
+    EXPECT_NE(error_of([&] {
+                  io::run_isolated([]() -> io::RawImport { throw std::runtime_error("oops"); }, "x.obj", lim);
+              }).find("the importer failed: oops"),
+              std::string::npos);
+}
+
+TEST(HostileInput, AParserOverItsMemoryLimitBecomesAnError) {
+#if defined(SKYBAKE_ASAN)
+    GTEST_SKIP() << "the address-space limit is off under AddressSanitizer (its shadow takes terabytes)";
+#else
+    ImportLimits lim;
+    lim.parser_memory_bytes = std::uint64_t(256) << 20;
+    const std::string msg = error_of([&] {
+        io::run_isolated(
+            []() -> io::RawImport {
+                std::vector<char> huge(std::size_t(4) << 30, 1); // 4 GiB > 256 MiB
+                io::RawImport r;
+                r.report.source_meshes = std::size_t(huge[12345]);
+                return r;
+            },
+            "big.obj", lim);
+    });
+    EXPECT_NE(msg.find("ran out of memory (limit 256 MiB)"), std::string::npos) << msg;
+#endif
 }

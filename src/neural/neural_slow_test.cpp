@@ -3,6 +3,7 @@
 // documented in docs/neural.md, a larger topology does better on the same
 // data, and the error report agrees with an independent recomputation.
 #include <cmath>
+#include <cstdio>
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
@@ -34,8 +35,11 @@ TEST(NeuralSlow, SeedTopologyLearnsAndLargerIsBetter) {
     const NeuralSky paper = train("paper", 30, 15);
     const NeuralSky wide = train("independent:16x16", 80, 5);
     // docs/neural.md: the seed's topology reaches a held-out RMS of about
-    // 0.027 on 800,000 samples; a constant predictor has about 0.25.
+    // 0.027 on 800,000 samples; a constant predictor has about 0.25. On these
+    // 200,000 samples, measured: 0.0347 (paper) and 0.0237 (16x16); day
+    // medians 0.286 and 0.079. Each bound is about 1.3× its figure.
     EXPECT_LT(paper.training.heldout_rms, 0.045);
+    EXPECT_LT(wide.training.heldout_rms, 0.031);
     EXPECT_LT(wide.training.heldout_rms, 0.8 * paper.training.heldout_rms);
 
     NeuralErrorOptions eo;
@@ -43,8 +47,10 @@ TEST(NeuralSlow, SeedTopologyLearnsAndLargerIsBetter) {
     eo.views = false;
     const NeuralErrorReport a = measure_neural_sky_error(paper, eo);
     const NeuralErrorReport b = measure_neural_sky_error(wide, eo);
-    EXPECT_LT(a.day.p50, 0.35);
-    EXPECT_LT(b.day.p50, a.day.p50);
+    std::printf("paper: held-out RMS %.4f, day p50 %.4f; independent:16x16: held-out RMS %.4f, day p50 %.4f\n",
+                paper.training.heldout_rms, a.day.p50, wide.training.heldout_rms, b.day.p50);
+    EXPECT_LT(a.day.p50, 0.37);
+    EXPECT_LT(b.day.p50, 0.10);
     EXPECT_EQ(a.all.count, a.day.count + a.twilight.count);
     EXPECT_EQ(a.all.count + a.night.count, 20000u);
 
@@ -69,6 +75,11 @@ TEST(NeuralSlow, ViewsOfATrainedNetworkResembleTheReference) {
     eo.view_height = 80;
     const NeuralErrorReport r = measure_neural_sky_error(net, eo);
     ASSERT_EQ(r.views.size(), 6u);
-    // docs/neural.md: about 26 dB for this topology trained on 800,000 samples.
-    EXPECT_GT(r.mean_view_psnr_db, 18.0);
+    std::printf("independent:16x16, 30 epochs: mean view PSNR %.2f dB, worst %.2f dB\n", r.mean_view_psnr_db,
+                r.min_view_psnr_db);
+    // docs/neural.md: about 26 dB for this topology trained on 800,000 samples;
+    // measured here (200,000 samples, 30 epochs) 22.8 dB mean, 19.6 dB worst.
+    // 1.3× the mean squared error is 1.14 dB less.
+    EXPECT_GT(r.mean_view_psnr_db, 21.6);
+    EXPECT_GT(r.min_view_psnr_db, 18.4);
 }

@@ -266,6 +266,40 @@ TEST(NeuralEncoding, RoundTripsAndNight) {
     EXPECT_NEAR(enc[3], 0.05f + 0.9f / 3.0f, 1e-6f);
 }
 
+TEST(NeuralEncoding, DecodeRuleBelowTheOffsetIsZero) {
+    // Decoding: c = (x − 0.05)/0.9, and 0 for x ≤ 0.05; a brightness output at
+    // or below 0.05 is night, whatever the colour outputs say.
+    for (BrightnessEncoding b : {BrightnessEncoding::Log, BrightnessEncoding::Seed}) {
+        NeuralEncoding e;
+        e.brightness = b;
+        e.max_n = 0.5;
+        // M = 1 (x = 0.95): N = max_n for both encodings.
+        const float bright[4] = {0.95f, 0.5f, 0.04f, 0.95f};
+        const glm::vec3 d = decode_sky_radiance(e, bright);
+        EXPECT_NEAR(d.x, 0.5f, 1e-6f);
+        EXPECT_NEAR(d.y, (0.5f - 0.05f) / 0.9f * 0.5f, 1e-6f);
+        EXPECT_EQ(d.z, 0.0f); // 0.04 < 0.05: clamped to 0, not negative
+        const float at_offset[4] = {0.05f, -0.3f, 0.0f, 0.95f};
+        EXPECT_EQ(decode_sky_radiance(e, at_offset), glm::vec3(0.0f));
+        for (float m : {0.05f, 0.049f, 0.0f, -1.0f}) {
+            const float night[4] = {0.9f, 0.9f, 0.9f, m};
+            EXPECT_EQ(decode_sky_radiance(e, night), glm::vec3(0.0f)) << m;
+        }
+        const float nan_m[4] = {0.9f, 0.9f, 0.9f, std::nanf("")};
+        EXPECT_EQ(decode_sky_radiance(e, nan_m), glm::vec3(0.0f));
+    }
+    // Seed brightness is linear in M; log brightness is max_n · exp(range (M − 1)).
+    NeuralEncoding seed;
+    seed.brightness = BrightnessEncoding::Seed;
+    seed.max_n = 0.5;
+    const float half[4] = {0.95f, 0.95f, 0.95f, 0.5f};
+    EXPECT_NEAR(decode_sky_radiance(seed, half).x, 0.5f * 0.5f, 1e-6f);
+    NeuralEncoding lg;
+    lg.max_n = 0.5;
+    lg.log_range = std::log(1e3);
+    EXPECT_NEAR(decode_sky_radiance(lg, half).x, 0.5 * std::exp(std::log(1e3) * -0.5), 1e-6);
+}
+
 TEST(NeuralTraining, LossDecreasesAndIsDeterministic) {
     SkyModelOptions so;
     so.tables = {64, 32};

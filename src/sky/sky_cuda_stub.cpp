@@ -1,5 +1,6 @@
 // Without CUDA in the build, the GPU entry points explain why they cannot run.
 #if !defined(SKYBAKE_HAS_CUDA)
+#include "skybake/error.h"
 #include "skybake/core.h"
 #include "skybake/sky.h"
 
@@ -9,7 +10,9 @@ void evaluate_sky_cuda(const SkyModel&, std::span<const SkySample>, std::span<gl
     require_cuda_device("--device cuda"); // throws
 }
 
-Image render_sky_cuda(const SkyModel&, const SkyRenderSettings&) {
+Image render_sky_cuda(const SkyModel&, const SkyRenderSettings& settings) {
+    if (settings.method != SkyMethod::Tables) // the same first check as the CUDA build's
+        throw Error("the exact method runs on the CPU only; use --device cpu or --method tables", "--device cuda");
     require_cuda_device("--device cuda"); // throws
     return {};
 }
