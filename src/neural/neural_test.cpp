@@ -15,6 +15,7 @@
 #include "skybake/core.h"
 #include "skybake/error.h"
 #include "skybake/neural.h"
+#include "neural/error_bound_test_util.h"
 
 using namespace skybake;
 using namespace skybake::neural;
@@ -298,6 +299,31 @@ TEST(NeuralEncoding, DecodeRuleBelowTheOffsetIsZero) {
     lg.max_n = 0.5;
     lg.log_range = std::log(1e3);
     EXPECT_NEAR(decode_sky_radiance(lg, half).x, 0.5 * std::exp(std::log(1e3) * -0.5), 1e-6);
+}
+
+TEST(NeuralErrorBound, CoversTheBatchAgainstTheScalarPassAndIsNotVacuous) {
+    // The bound the GPU tests use (error_bound_test_util.h), tried on the two
+    // CPU evaluators, which round differently too (Eigen's order and exp).
+    for (const char* topology : {"paper", "independent:16x16", "shared:32x32"}) {
+        SCOPED_TRACE(topology);
+        const NeuralSky net = neural_test::random_network(topology, 5);
+        const auto e = neural_test::encoded_error_bound(net);
+        std::printf("%s: modelled bound on the encoded outputs %.2e %.2e %.2e %.2e\n", topology, e[0], e[1], e[2], e[3]);
+        if (std::string(topology) == "paper")
+            EXPECT_LT(*std::max_element(e.begin(), e.end()), 2e-6); // a few ulps
+        const auto samples = draw_sky_samples(20000, 9);
+        std::vector<glm::vec3> batch(samples.size()), scalar(samples.size());
+        evaluate_neural_sky(net, samples, batch);
+        for (std::size_t i = 0; i < samples.size(); ++i)
+            scalar[i] = neural_sky_radiance(net, samples[i]);
+        neural_test::expect_within_modelled_bound(net, samples, scalar, batch);
+        // The bound can fail: one weight off by 0.05 leaves it on many samples.
+        NeuralSky off = net;
+        off.weights[3] += 0.05f;
+        std::vector<glm::vec3> wrong(samples.size());
+        evaluate_neural_sky(off, samples, wrong);
+        EXPECT_GT(neural_test::check_modelled_bound(net, samples, scalar, wrong).outside, samples.size() / 100);
+    }
 }
 
 TEST(NeuralTraining, LossDecreasesAndIsDeterministic) {

@@ -1,8 +1,11 @@
 // The CUDA sky against the CPU path on the same inputs. Skips without a GPU.
-// Metric: the largest relative difference of a sample's radiance, and for
-// images Bruneton's GPU-vs-CPU criterion, PSNR >= 47 dB.
+// Metric: per-sample differences against a rounding model measured on the
+// CPU (see SamplesMatchTheCpu), and for images Bruneton's GPU-vs-CPU
+// criterion, PSNR >= 47 dB.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -10,6 +13,7 @@
 #include "skybake/error.h"
 #include "skybake/sky.h"
 #include "core/gpu_test.h"
+#include "sky/rounding_model_test_util.h"
 
 using namespace skybake;
 
@@ -37,6 +41,13 @@ TEST(SkyCuda, WithoutADeviceTheErrorIsClear) {
 }
 
 TEST(SkyCuda, SamplesMatchTheCpu) {
+    // Metric (rounding_model_test_util.h): per sample, the largest channel
+    // difference over the sample's largest channel, floored at 1e-3 of the
+    // brightest. The bulk moves by rounding only: p50 ≤ 1e-5, p90 ≤ 1e-4.
+    // Beyond that a sample may differ by as much as the CPU's own sensitivity
+    // to its inputs (twice it, or 1e-4), since near the step split or a shadow
+    // boundary other rounding flips a discrete choice; at most 1e-4 of the
+    // samples may fall outside that model.
     SKYBAKE_SKIP_WITHOUT_GPU();
     for (const char* preset : {"earth", "paper", "paper-dense"}) {
         SCOPED_TRACE(preset);
@@ -45,13 +56,22 @@ TEST(SkyCuda, SamplesMatchTheCpu) {
         std::vector<glm::vec3> cpu(samples.size()), gpu(samples.size());
         evaluate_sky(model, samples, cpu, SkyMethod::Tables);
         evaluate_sky_cuda(model, samples, gpu);
-        double worst = 0.0;
+        const double floor = sky_test::difference_floor(cpu);
+        const std::vector<double> sensitivity = sky_test::rounding_sensitivity(model, samples, cpu, floor);
+        std::vector<double> diff(samples.size());
+        std::size_t lit = 0, unexplained = 0;
         for (std::size_t i = 0; i < samples.size(); ++i) {
-            const double ref = std::max({double(cpu[i].x), double(cpu[i].y), double(cpu[i].z), 1e-7});
-            for (int c = 0; c < 3; ++c)
-                worst = std::max(worst, std::abs(double(gpu[i][c]) - double(cpu[i][c])) / ref);
+            diff[i] = sky_test::sample_difference(gpu[i], cpu[i], floor);
+            lit += std::max({cpu[i].x, cpu[i].y, cpu[i].z}) > 0.0f;
+            unexplained += diff[i] > std::max(1e-4, 2.0 * sensitivity[i]);
         }
-        EXPECT_LT(worst, 1e-4);
+        const double p50 = sky_test::quantile(diff, 0.5), p90 = sky_test::quantile(diff, 0.9);
+        std::printf("%s: %zu lit of %zu; GPU - CPU p50 %.1e, p90 %.1e, max %.1e; %zu outside the rounding model\n",
+                    preset, lit, samples.size(), p50, p90, *std::max_element(diff.begin(), diff.end()), unexplained);
+        EXPECT_GE(lit, samples.size() / 4);
+        EXPECT_LE(p50, 1e-5);
+        EXPECT_LE(p90, 1e-4);
+        EXPECT_LE(double(unexplained), 1e-4 * double(samples.size()));
     }
 }
 

@@ -1,7 +1,11 @@
 // The CUDA bake's thread bodies on the host against the Embree bake, on
 // larger inputs: two real models and the seed's table case (5k vertices,
-// lebedev:5810).
+// lebedev:5810), and every setting the GPU tests use, so that a run on a GPU
+// only has to confirm the same numbers.
 #include <gtest/gtest.h>
+
+#include <tuple>
+#include <utility>
 
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
@@ -39,4 +43,62 @@ TEST(CudaBakeSlow, RealModelsMatchEmbree) {
 
 TEST(CudaBakeSlow, SeedTableCaseMatchesEmbree) {
     check("city", ao_test::generated(ProceduralKind::City, 3000), "lebedev:5810", false);
+}
+
+TEST(CudaBakeSlow, TheGpuTestsSettingsPassOnTheHost) {
+    // cuda_backend_gpu_test.cpp, EveryMethodMatchesEmbreeAndTheHostEmulation:
+    // the same scenes, rules and back-face modes, with the same bounds.
+    for (const auto& [name, m] : scenes())
+        for (const char* spec : gpu_test_rules())
+            for (BackFaces back : gpu_test_back_faces()) {
+                const SphereRule rule = parse_rule(spec);
+                const std::string label = name + " " + spec + " " + back_faces_name(back) + ", host emulation";
+                SCOPED_TRACE(label);
+                BakeOptions o;
+                o.store_bits = true;
+                o.back_faces = back;
+                BakeOutputs e;
+                EmbreeBackend().bake(m, rule, o, e);
+                const Agreement a = compare_bakes(m, rule, o, emulated(m, rule, o, TraceMethod::Bvh), e);
+                a.print(label.c_str());
+                expect_agreement(a, tie_free(name, rule));
+            }
+}
+
+TEST(CudaBakeSlow, TheGpuTestsRealModelsPassOnTheHost) {
+    // cuda_backend_gpu_test.cpp, RealModelsMatchEmbree: strict bounds on both.
+    const std::string models = SKYBAKE_ASSIMP_MODELS;
+    for (const auto& [label, path, spec] :
+         {std::tuple<const char*, const char*, const char*>{"engine", "/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb",
+                                                            "lebedev:110+rotate"},
+          {"wuson", "/OBJ/WusonOBJ.obj", "lebedev:5810"}}) {
+        const Mesh m = load_mesh(models + path);
+        const SphereRule rule = parse_rule(spec);
+        BakeOptions o;
+        o.store_bits = true;
+        BakeOutputs e;
+        EmbreeBackend().bake(m, rule, o, e);
+        const Agreement a = compare_bakes(m, rule, o, emulated(m, rule, o, TraceMethod::Bvh), e);
+        a.print((std::string(label) + " " + spec + ", host emulation").c_str());
+        expect_agreement(a, true);
+    }
+}
+
+TEST(CudaBakeSlow, TheGpuCliTestsMeshesPassOnTheHost) {
+    // tests/ao_gpu_test.cpp: a 5,000-triangle city and spider.obj at
+    // lebedev:1202 (no rotation), at most 1e-4 of the bits differing and mean
+    // AO within 1e-4.
+    const Mesh city = ao_test::generated(ProceduralKind::City, 5000), spider_mesh = spider();
+    for (const auto& [label, m] : {std::pair<const char*, const Mesh&>{"city", city}, {"spider", spider_mesh}}) {
+        const SphereRule rule = parse_rule("lebedev:1202");
+        BakeOptions o;
+        o.store_bits = true;
+        BakeOutputs e;
+        EmbreeBackend().bake(m, rule, o, e);
+        const BakeOutputs g = emulated(m, rule, o, TraceMethod::Bvh);
+        const Agreement a = compare_bakes(m, rule, o, g, e);
+        a.print((std::string(label) + " lebedev:1202, host emulation").c_str());
+        EXPECT_LE(double(differing_bits(g, e)), 1e-4 * double(a.rays)) << label;
+        EXPECT_LE(a.mean_ao, 1e-4) << label;
+    }
 }

@@ -47,10 +47,9 @@ TEST(CudaBackendGpu, EveryMethodMatchesEmbreeAndTheHostEmulation) {
     SKYBAKE_SKIP_WITHOUT_GPU();
     CudaBackend cuda;
     std::printf("device: %s\n", cuda.device_name().c_str());
-    const char* rules[] = {"lebedev:590", "lebedev:302+rotate", "lebedev:5810"};
     for (const auto& [name, m] : scenes())
-        for (const char* spec : rules)
-            for (BackFaces back : {BackFaces::Occlude, BackFaces::Ignore}) {
+        for (const char* spec : gpu_test_rules())
+            for (BackFaces back : gpu_test_back_faces()) {
                 const SphereRule rule = parse_rule(spec);
                 BakeOptions o;
                 o.store_bits = true;

