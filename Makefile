@@ -34,9 +34,10 @@ test: build
 test-fast: build
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) -L 'unit|io'
 
-# The GPU tests alone, verbosely; they skip themselves without a CUDA device.
+# The GPU tests alone, verbosely, on a machine with a CUDA device: with
+# SKYBAKE_REQUIRE_GPU=1 a missing or broken device fails them instead of skipping.
 test-gpu: build
-	ctest --test-dir $(BUILD) --output-on-failure -L gpu -V
+	SKYBAKE_REQUIRE_GPU=1 ctest --test-dir $(BUILD) --output-on-failure -L gpu -V
 
 # ASan + UBSan build of the I/O tests (label "io"): hostile files must not crash.
 test-sanitize: deps

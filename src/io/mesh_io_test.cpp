@@ -273,7 +273,7 @@ TEST(RealMeshes, GltfNodeTransformsAreApplied) {
     }
     const double h = std::sqrt(0.5);
     std::ofstream(dir / "tri.gltf") << R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
- "nodes": [{"translation": [10, 0, 0], "scale": [2, 1, 1], "children": [1]},
+ "nodes": [{"translation": [10, 5, 0], "scale": [2, 1, 1], "children": [1]},
            {"rotation": [)" << h << ", 0, 0, " << h << R"(], "mesh": 0}],
  "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2}]}],
  "buffers": [{"uri": "tri.bin", "byteLength": 84}],
@@ -284,8 +284,8 @@ TEST(RealMeshes, GltfNodeTransformsAreApplied) {
                {"bufferView": 2, "componentType": 5125, "count": 3, "type": "SCALAR"}]})";
     const Mesh m = load_mesh(dir / "tri.gltf");
     ASSERT_EQ(m.vertex_count(), 3u);
-    // R_x(90°): (x, y, z) → (x, −z, y); then S = diag(2, 1, 1); then + (10, 0, 0).
-    const glm::vec3 expected[3] = {{10, 0, 0}, {12, 0, 0}, {10, 0, 1}};
+    // R_x(90°): (x, y, z) → (x, −z, y); then S = diag(2, 1, 1); then + (10, 5, 0).
+    const glm::vec3 expected[3] = {{10, 5, 0}, {12, 5, 0}, {10, 5, 1}};
     for (int v = 0; v < 3; ++v)
         for (int k = 0; k < 3; ++k)
             EXPECT_NEAR(m.positions[v][k], expected[v][k], 1e-6f) << "vertex " << v << " axis " << k;
