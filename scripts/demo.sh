@@ -8,10 +8,23 @@ build=${1:-build}
 case "$build" in /*) ;; *) build=$root/$build ;; esac
 sky=$build/bin/skybake
 out=$root/out/demo
+rm -rf "$out" # the summary lists what this run wrote, nothing older
 mkdir -p "$out"
 models=/usr/share/assimp/models
 
 step() { printf '\n== %s\n' "$*"; }
+
+# Runs a command that must be refused: prints its one error line as an
+# expected result, and stops the demo if it succeeds instead.
+expect_refusal() {
+  local err
+  if err=$("$@" 2>&1 >/dev/null); then
+    echo "expected an error from: $*" >&2
+    exit 1
+  fi
+  printf '  refused, as expected: %s\n' "${err#skybake: error: }"
+}
+export -f expect_refusal
 
 "$sky" --version
 
@@ -25,9 +38,7 @@ step "a real mesh, flattened and converted"
 "$sky" mesh info "$out/engine.glb"
 
 step "a broken file is refused with one line"
-if "$sky" mesh info "$models/glTF2/IndexOutOfRange/IndexOutOfRange.gltf"; then
-  echo "expected an error" >&2; exit 1
-fi
+expect_refusal "$sky" mesh info "$models/glTF2/IndexOutOfRange/IndexOutOfRange.gltf"
 
 # Further stages (sky, baking) append here as they exist.
 for stage in "$root"/scripts/demo.d/*.sh; do

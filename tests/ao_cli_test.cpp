@@ -124,19 +124,26 @@ TEST(AoCli, BadInputIsOneLineAndNoOutput) {
     const std::string dir = skybake::test::temp_dir("ao-cli-errors");
     const std::string in = wall_mesh(dir), out = dir + "/out.glb";
     expect_one_line_error(run_cli({"ao", dir + "/missing.obj", "-o", out}), 1, "missing.obj");
-    expect_one_line_error(run_cli({"ao", in, "-o", out, "--rule", "lebedev:500"}), 1, "lebedev");
-    expect_one_line_error(run_cli({"ao", in, "-o", out, "--rule", "phong:a=4,n=3"}), 1, "Phong");
-    if (skybake::cuda_device_count() == 0) // no GPU, or a build without CUDA
-        expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "cuda"}), 1, "--backend cuda");
-    expect_one_line_error(run_cli({"ao", in, "-o", out, "--method", "per-vertex"}), 1, "--backend cuda");
-    expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "cuda", "--method", "octree"}), 1, "--method");
-    expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "optix"}), 1, "--backend");
-    expect_one_line_error(run_cli({"ao", in, "-o", dir + "/out.obj"}), 1, "--output");
-    expect_one_line_error(run_cli({"ao", in, "-o", out, "--preview", dir + "/p.jpg"}), 1, "--preview");
-    expect_one_line_error(run_cli({"ao", in, "-o", out, "--preview-size", "0x5"}), 1, "--preview-size");
-    expect_one_line_error(run_cli({"ao", in, "-o", out, "--max-distance", "0"}), 1, "--max-distance");
-    expect_one_line_error(run_cli({"ao", in, "-o", out, "--offset", "-3"}), 1, "--offset");
-    expect_one_line_error(run_cli({"ao", in, "-o", out, "--back-faces", "cull"}), 1, "--back-faces");
+    // A bad flag value is a usage error: exit 2, naming the flag.
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--rule", "lebedev:500"}), 2, "lebedev");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--rule", "phong:a=4,n=3"}), 2, "Phong");
+    if (skybake::cuda_device_count() == 0) { // no GPU, or a build without CUDA: a runtime error
+        expect_one_line_error(run_cli({"ao", in, "-o", out, "--device", "cuda"}), 1, "--device cpu");
+        expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "cuda"}), 1, "--device cpu");
+    }
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--method", "per-vertex"}), 2, "--device cuda");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--device", "cuda", "--method", "octree"}), 2, "--method");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "optix"}), 2, "--backend");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--device", "cuda", "--backend", "embree"}), 2, "--backend");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--device", "tpu"}), 2, "--device");
+    expect_one_line_error(run_cli({"ao", in, "-o", dir + "/out.obj"}), 2, "--output");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--preview", dir + "/p.jpg"}), 2, "--preview");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--preview", dir + "/p.png", "--preview-size", "0x5"}), 2,
+                          "--preview-size");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--preview-size", "64x64"}), 2, "without --preview");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--max-distance", "0"}), 2, "--max-distance");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--offset", "-3"}), 2, "--offset");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--back-faces", "cull"}), 2, "--back-faces");
     // Brute force refuses a large mesh.
     const std::string big = dir + "/big.glb";
     ASSERT_EQ(run_cli({"mesh", "generate", "--kind", "sphere", "--triangles", "40000", "-o", big}).exit_code, 0);

@@ -34,7 +34,8 @@ TEST(AoGpuCli, EveryMethodMatchesEmbree) {
             const auto jg = nlohmann::json::parse(g.out);
             EXPECT_EQ(jg["backend"], "cuda");
             EXPECT_EQ(jg["method"], method);
-            EXPECT_FALSE(jg["device"].get<std::string>().empty());
+            EXPECT_EQ(jg["device"], "cuda");
+            EXPECT_FALSE(jg["gpu"].get<std::string>().empty());
             EXPECT_EQ(jg["rays"], je["rays"]);
             EXPECT_NEAR(jg["ao"]["mean"].get<double>(), je["ao"]["mean"].get<double>(), 1e-4);
             const skybake::VisibilityBits bg = skybake::load_visibility_bits(dir + "/g.bits");

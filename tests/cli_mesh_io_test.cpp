@@ -60,12 +60,12 @@ TEST(CliMesh, UsageErrorsExitTwo) {
     expect_one_line_error(run_cli({"mesh", "frobnicate"}), 2);
 }
 
-TEST(CliMesh, BadValuesExitOne) {
+TEST(CliMesh, BadValuesAreUsageErrorsAndMissingFoldersRuntimeErrors) {
     const std::string dir = temp_dir("cli-bad");
-    expect_one_line_error(run_cli({"mesh", "generate", "--kind", "teapot", "-o", dir + "/t.glb"}));
-    expect_one_line_error(run_cli({"mesh", "generate", "--triangles", "3", "-o", dir + "/t.glb"}));
-    expect_one_line_error(run_cli({"mesh", "generate", "-o", dir + "/t.obj"}));
-    expect_one_line_error(run_cli({"mesh", "generate", "-o", dir + "/no/such/dir/t.glb"}));
+    expect_one_line_error(run_cli({"mesh", "generate", "--kind", "teapot", "-o", dir + "/t.glb"}), 2);
+    expect_one_line_error(run_cli({"mesh", "generate", "--triangles", "3", "-o", dir + "/t.glb"}), 2);
+    expect_one_line_error(run_cli({"mesh", "generate", "-o", dir + "/t.obj"}), 2);
+    expect_one_line_error(run_cli({"mesh", "generate", "-o", dir + "/no/such/dir/t.glb"}), 1);
     EXPECT_TRUE(fs::is_empty(dir)) << "no output and no temporary file is left";
 }
 

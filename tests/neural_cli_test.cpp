@@ -86,7 +86,7 @@ TEST(NeuralCli, TrainRejectsBadFlags) {
         std::vector<std::string> a{"sky", "train", "-o", dir + "/w.json"};
         a.insert(a.end(), args.begin(), args.end());
         auto r = run_cli(a);
-        EXPECT_EQ(r.exit_code, 1) << args[0];
+        EXPECT_EQ(r.exit_code, 2) << args[0]; // a bad flag value is a usage error
         EXPECT_EQ(r.err_lines(), 1) << r.err;
         EXPECT_EQ(r.err.rfind("skybake: error: ", 0), 0u) << r.err;
         EXPECT_FALSE(fs::exists(dir + "/w.json"));
@@ -138,7 +138,7 @@ TEST(NeuralCli, EvalWithModelTakesTheSameCsv) {
     // The weights file carries its atmosphere.
     auto p = run_cli({"sky", "eval", "--model", tiny_model(), "--preset", "earth", "--input", in, "--output",
                       dir + "/p.csv"});
-    EXPECT_EQ(p.exit_code, 1);
+    EXPECT_EQ(p.exit_code, 2); // flags that do not go together: a usage error
     EXPECT_EQ(p.err_lines(), 1);
     EXPECT_NE(p.err.find("--preset"), std::string::npos) << p.err;
 }
@@ -154,7 +154,7 @@ TEST(NeuralCli, RenderWithModel) {
     EXPECT_GT(fs::file_size(dir + "/p.png"), 100u);
     auto bad = run_cli({"sky", "render", "--model", tiny_model(), "--altitude-km", "2", "--sun-elevation-deg", "20",
                         "--method", "exact", "-o", dir + "/x.png"});
-    EXPECT_EQ(bad.exit_code, 1);
+    EXPECT_EQ(bad.exit_code, 2);
     EXPECT_EQ(bad.err_lines(), 1);
     EXPECT_FALSE(fs::exists(dir + "/x.png"));
 }
@@ -169,7 +169,7 @@ TEST(NeuralCli, ExportEveryFormat) {
         EXPECT_NE(read(out).find("skybake_sky("), std::string::npos) << f;
     }
     auto r = run_cli({"sky", "export", tiny_model(), "--format", "metal", "-o", dir + "/sky.metal"});
-    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(r.err_lines(), 1);
     EXPECT_FALSE(fs::exists(dir + "/sky.metal"));
     auto u = run_cli({"sky", "export", tiny_model(), "-o", dir + "/x.glsl"}); // --format missing: usage error

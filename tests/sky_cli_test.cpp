@@ -159,7 +159,13 @@ TEST(SkyCli, EvalErrorsNameTheLine) {
     } cases[] = {
         {"1,1,1,1\n1,0.5,-0.5,1\n", "line 2"},           // impossible triple
         {"1,1,1,1\n0,0,0,0\n", "line 2"},                // density 0
-        {"h1,h2,h3,h4\n1,1,1,1.5\n", "line 2"},          // density > 1
+        {"cos_view_zenith,cos_view_sun,cos_sun_zenith,density\n1,1,1,1.5\n", "line 2"}, // density > 1
+        {"density,cos_sun_zenith,cos_view_sun,cos_view_zenith\n0.5,1,1,1\n1,1,1,0\n", "line 3"}, // by name: density 0
+        {"foo,bar,baz,qux\n1,1,1,1\n", "unknown column 'foo'"},
+        {"cos_view_zenith,cos_view_sun,density\n1,1,1\n", "no column 'cos_sun_zenith'"},
+        {"cos_view_zenith,cos_view_sun,cos_sun_zenith,cos_view_sun\n1,1,1,1\n", "appears twice"},
+        {"cos_view_zenith,cos_view_sun,cos_sun_zenith,density\n", "no samples"}, // a header only
+        {"", "no samples"},                                                        // empty
         {"1,1,1,1\n\n0.5,abc,0,1\n", "line 3"},          // not a number
         {"1,1,1\n", "line 1"},                            // three fields
     };
@@ -176,10 +182,10 @@ TEST(SkyCli, EvalErrorsNameTheLine) {
 
 TEST(SkyCli, BadFlagsAreOneLineErrors) {
     auto a = run_cli({"sky", "optical-length", "--preset", "mars", "--density", "1", "--cos-zenith", "1"});
-    EXPECT_EQ(a.exit_code, 1);
+    EXPECT_EQ(a.exit_code, 2);
     EXPECT_EQ(a.err_lines(), 1) << a.err;
     auto b = run_cli({"sky", "optical-length", "--preset", "earth", "--density", "1.5", "--cos-zenith", "1"});
-    EXPECT_EQ(b.exit_code, 1);
+    EXPECT_EQ(b.exit_code, 2);
     EXPECT_NE(b.err.find("--density"), std::string::npos);
     const std::string dir = temp_dir("sky_bad_json");
     const std::string bad = write(dir, "bad.json", "{\"planet_radius_km\": 6360, \"top_radius_km\": 6000}");
@@ -206,6 +212,6 @@ TEST(SkyCli, RenderWritesImages) {
     EXPECT_TRUE(std::filesystem::exists(exr));
     auto bad = run_cli({"sky", "render", "--preset", "earth", "--altitude-km", "0", "--sun-elevation-deg", "20",
                         "--view", "fish", "-o", dir + "/x.png"});
-    EXPECT_EQ(bad.exit_code, 1);
+    EXPECT_EQ(bad.exit_code, 2);
     EXPECT_EQ(bad.err_lines(), 1);
 }

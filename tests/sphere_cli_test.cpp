@@ -92,12 +92,12 @@ TEST(SphereCli, ExportWritesCsvRows) {
 TEST(SphereCli, BadInputIsOneLineAndNoOutputFile) {
     const std::string dir = skybake::test::temp_dir("sphere-bad");
     auto r = run_cli({"sphere", "export", "lebedev:500", "-o", dir + "/x.csv"});
-    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.exit_code, 2); // a bad rule spec is a bad argument: a usage error
     EXPECT_EQ(r.err_lines(), 1) << r.err;
     EXPECT_NE(r.err.find("available point counts are 6, 14"), std::string::npos) << r.err;
     EXPECT_FALSE(std::ifstream(dir + "/x.csv").good());
     auto s = run_cli({"sphere", "show", "phong:a=4"});
-    EXPECT_EQ(s.exit_code, 1);
+    EXPECT_EQ(s.exit_code, 2);
     EXPECT_EQ(s.err_lines(), 1) << s.err;
     auto u = run_cli({"sphere", "export", "lebedev:6"}); // missing -o
     EXPECT_EQ(u.exit_code, 2);

@@ -1,4 +1,4 @@
-// skybake ao INPUT -o OUTPUT.glb|.ply [--rule R] [--backend B] [--method M] [--max-distance D] [--offset E]
+// skybake ao INPUT -o OUTPUT.glb|.ply [--rule R] [--device D] [--backend B] [--method M] [--max-distance D] [--offset E]
 //            [--back-faces occlude|ignore] [--normalize] [--bits FILE] [--preview FILE.png]
 //            [--preview-size WxH] [--json]
 #include <algorithm>
@@ -9,6 +9,8 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "flags.h"
+#include "skybake/files.h"
 #include "skybake/bake.h"
 #include "skybake/core.h"
 #include "skybake/mesh.h"
@@ -24,10 +26,11 @@ constexpr const char* kDefaultRule = "lebedev:590";
 struct AoOptions {
     std::string input, output;
     std::string rule = kDefaultRule;
-    std::string backend = "embree";
+    std::string device = "cpu";
+    std::string backend; // empty: embree on the CPU, cuda on the GPU
     std::string method = "bvh";
     double max_distance = std::numeric_limits<double>::infinity();
-    double offset = -1.0;
+    std::string offset = "auto";
     std::string back_faces = "occlude";
     bool normalize = false;
     std::string bits;
@@ -36,12 +39,6 @@ struct AoOptions {
     float azimuth_deg = 35.0f, elevation_deg = 30.0f;
     bool json = false;
 };
-
-std::string lower_extension(const std::string& path) {
-    std::string e = std::filesystem::path(path).extension().string();
-    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-    return e;
-}
 
 // The GPU a backend runs on ("" for the CPU backends).
 std::string device_name(const VisibilityBackend& backend) {
@@ -61,39 +58,52 @@ nlohmann::json stats(const std::vector<float>& v) {
     return {{"min", lo}, {"mean", sum / double(v.size())}, {"max", hi}};
 }
 
-void run(const AoOptions& o) {
+// The backend for --device and --backend: one way to say where the work runs
+// (--device, as for the sky commands), and --backend to pick a CPU backend.
+std::string backend_name(const AoOptions& o) {
+    const Device device = parse_flag("--device", [&] { return parse_device(o.device); });
+    if (o.backend.empty())
+        return device == Device::Cuda ? "cuda" : "embree";
+    if (o.backend != "embree" && o.backend != "brute" && o.backend != "cuda")
+        throw UsageError(fmt::format("unknown backend '{}'; use embree, brute or cuda", o.backend), "--backend");
+    if (device == Device::Cuda && o.backend != "cuda")
+        throw UsageError(fmt::format("--backend {} runs on the CPU, but --device is cuda", o.backend), "--backend");
+    return o.backend;
+}
+
+void run(const AoOptions& o, const CLI::App& sub) {
     // Everything that can be checked without the mesh is checked first, so a
     // typo fails at once and no output file is started.
-    const SphereRule rule = parse_rule(o.rule);
-    const TraceMethod method = parse_trace_method(o.method);
-    if (method != TraceMethod::Bvh && o.backend != "cuda")
-        throw Error(fmt::format("--method {} is a method of the cuda backend; add --backend cuda", o.method),
-                    "--method");
-    const auto backend = make_visibility_backend(o.backend);
-    const std::string out_ext = lower_extension(o.output);
-    if (out_ext != ".glb" && out_ext != ".ply")
-        throw Error(fmt::format("cannot write '{}' meshes; use .glb or .ply", out_ext.empty() ? "(none)" : out_ext),
-                    "--output");
-    if (!o.preview.empty()) {
-        const std::string e = lower_extension(o.preview);
-        if (e != ".png" && e != ".exr")
-            throw Error(fmt::format("cannot write '{}' images; use .png or .exr", e.empty() ? "(none)" : e),
-                        "--preview");
-    }
+    const SphereRule rule = parse_flag("--rule", [&] { return parse_rule(o.rule); });
+    if (rule.kind == RuleKind::Phong)
+        throw UsageError(fmt::format("'{}' integrates against a Phong lobe, not over the sphere; use a lebedev, "
+                                     "design, fibonacci or mc rule for ambient occlusion",
+                                     rule.spec),
+                         "--rule");
+    const TraceMethod method = parse_flag("--method", [&] { return parse_trace_method(o.method); });
+    const std::string backend_id = backend_name(o);
+    if (method != TraceMethod::Bvh && backend_id != "cuda")
+        throw UsageError(fmt::format("--method {} is a method of the GPU backend; add --device cuda", o.method),
+                         "--method");
+    const BackFaces back_faces = parse_flag("--back-faces", [&] { return parse_back_faces(o.back_faces); });
     AoPreviewOptions preview;
-    parse_size(o.preview_size, preview.width, preview.height, "--preview-size");
+    parse_flag("--preview-size", [&] { parse_size(o.preview_size, preview.width, preview.height, "--preview-size"); });
+    if (o.preview.empty())
+        for (const char* f : {"--preview-size", "--preview-azimuth", "--preview-elevation"})
+            refuse_if_given(sub, f, "without --preview");
     preview.azimuth_deg = o.azimuth_deg;
     preview.elevation_deg = o.elevation_deg;
-    if (std::isnan(o.max_distance) || o.max_distance <= 0.0)
-        throw Error(fmt::format("maximum distance must be > 0 mesh units; got {}", o.max_distance), "--max-distance");
-    if (!std::isfinite(o.offset) || (o.offset < 0.0 && o.offset != -1.0))
-        throw Error(fmt::format("ray offset must be a finite distance ≥ 0 in mesh units; got {}", o.offset),
-                    "--offset");
+    check_output_path(o.output, {".glb", ".ply"}, "--output");
+    if (!o.preview.empty())
+        check_output_path(o.preview, {".png", ".exr"}, "--preview");
+    if (!o.bits.empty())
+        check_output_path(o.bits, {}, "--bits");
+    const auto backend = make_visibility_backend(backend_id); // no GPU: a runtime error, exit 1
 
     BakeOptions b;
     b.max_distance = float(o.max_distance);
-    b.ray_offset = float(o.offset);
-    b.back_faces = parse_back_faces(o.back_faces);
+    b.ray_offset = o.offset == "auto" ? -1.0f : float(std::stod(o.offset)); // validated: auto or a number ≥ 0
+    b.back_faces = back_faces;
     b.normalize = o.normalize;
     b.store_bits = !o.bits.empty();
     b.method = method;
@@ -102,22 +112,24 @@ void run(const AoOptions& o) {
     BakeOutputs outputs;
     const AoBakeReport r = bake_ambient_occlusion(mesh, rule, *backend, b, &outputs);
 
-    // Render before writing anything: a failure leaves no partial set of outputs.
-    Image image;
+    // Every output is staged, then all are committed together: a failure in
+    // any one of them leaves none written.
+    OutputSet files;
+    save_mesh(files.stage(o.output), mesh);
     if (!o.preview.empty())
-        image = render_ao_preview(mesh, preview);
-    save_mesh(o.output, mesh);
-    if (!o.preview.empty())
-        save_image(o.preview, image, ToneMap{0.0f, ToneCurve::Clamp});
+        save_image(files.stage(o.preview), render_ao_preview(mesh, preview), ToneMap{0.0f, ToneCurve::Clamp});
     if (!o.bits.empty())
-        save_visibility_bits(o.bits, outputs, rule);
+        save_visibility_bits(files.stage(o.bits), outputs, rule);
+    files.commit();
 
     if (o.json) {
         nlohmann::json j = {{"input", o.input},
                             {"output", o.output},
                             {"backend", r.backend},
                             {"method", r.method},
-                            {"device", device_name(*backend)},
+                            {"device", std::string(backend->name()) == "cuda" ? "cuda" : "cpu"},
+                            {"gpu", device_name(*backend).empty() ? nlohmann::json(nullptr)
+                                                                  : nlohmann::json(device_name(*backend))},
                             {"rule", r.rule},
                             {"directions", r.directions},
                             {"vertices", r.vertices},
@@ -170,18 +182,22 @@ void add_ao_bake(CLI::App& group) {
                     "Sphere rule, e.g. lebedev:5810, design:t21, fibonacci:1000, mc:4096; add +rotate for a random "
                     "rotation per vertex (see 'sphere list')")
         ->capture_default_str();
+    sub->add_option("--device", o->device, "Where the bake runs: cpu, or cuda (an NVIDIA GPU)")->capture_default_str();
     sub->add_option("--backend", o->backend,
-                    "Visibility backend: embree (CPU), cuda (NVIDIA GPU), or brute (test oracle, small meshes)")
-        ->capture_default_str();
+                    "Visibility backend: embree (CPU; the default with --device cpu), brute (test oracle, small "
+                    "meshes) or cuda (the default with --device cuda)");
     sub->add_option("--method", o->method,
-                    "How the cuda backend finds blockers: bvh, per-vertex (every triangle for every ray, the seed's "
+                    "How the GPU backend finds blockers: bvh, per-vertex (every triangle for every ray, the seed's "
                     "naive method) or per-polygon (every triangle, cached in shared memory)")
         ->capture_default_str();
     sub->add_option("--max-distance", o->max_distance,
-                    "Ignore occluders further than this, in mesh units (default: unlimited)");
+                    "Ignore occluders further than this, in mesh units (default: unlimited)")
+        ->check(real_in(0.0, INFINITY, "mesh units", End::Open));
     sub->add_option("--offset", o->offset,
-                    "Move ray origins this far along the normal, in mesh units (default: 1e-4 x bounding-box "
-                    "diagonal)");
+                    "Move ray origins this far along the normal, in mesh units; auto: 1e-4 x the bounding-box "
+                    "diagonal")
+        ->check(auto_or_real_in(0.0, INFINITY, "mesh units"))
+        ->capture_default_str();
     sub->add_option("--back-faces", o->back_faces,
                     "occlude: both sides of a triangle block rays; ignore: rays pass through triangles seen from "
                     "behind (open, single-sided meshes)")
@@ -192,11 +208,13 @@ void add_ao_bake(CLI::App& group) {
     sub->add_option("--preview", o->preview, "Also write a preview image (.png or .exr) shaded by the baked AO");
     sub->add_option("--preview-size", o->preview_size, "Preview size WxH in pixels")->capture_default_str();
     sub->add_option("--preview-azimuth", o->azimuth_deg, "Preview camera azimuth around +y, degrees")
+        ->check(real_in(-360.0, 360.0, "degrees"))
         ->capture_default_str();
     sub->add_option("--preview-elevation", o->elevation_deg, "Preview camera elevation, degrees")
+        ->check(real_in(-90.0, 90.0, "degrees"))
         ->capture_default_str();
     add_json_flag(*sub, o->json);
-    sub->callback([o] { run(*o); });
+    sub->callback([o, sub] { run(*o, *sub); });
 }
 
 SKYBAKE_CLI_GROUP_COMMAND("ao", add_ao_bake)

@@ -1,6 +1,7 @@
 // skybake: the command-line tool.
 //
-// Exit codes: 0 success; 1 runtime or input error; 2 usage error.
+// Exit codes: 0 success; 1 runtime or input error; 2 usage error (a bad flag
+// or flag value); 128 + N when stopped by signal N (SIGINT, SIGTERM).
 // Errors are one line on stderr:  skybake: error: <what went wrong> (<where>)
 #include <cstdio>
 #include <exception>
@@ -10,8 +11,10 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "flags.h"
 #include "skybake/core.h"
 #include "skybake/error.h"
+#include "skybake/interrupt.h"
 
 namespace {
 
@@ -27,6 +30,43 @@ std::string version_line() {
 
 void print_error(const std::string& line) { std::fprintf(stderr, "skybake: error: %s\n", line.c_str()); }
 
+// The command chain as far as it is known ("skybake sky"), for the usage hint.
+std::string command_path(const CLI::App* app) {
+    std::string s;
+    for (; app; app = app->get_parent())
+        s = app->get_name() + (s.empty() ? "" : " " + s);
+    return s;
+}
+
+// After "A subcommand is required": the first word that names no command of
+// the level it is given at, if any, as a clearer message than CLI11's.
+std::string unknown_command(CLI::App& app, int argc, char** argv) {
+    CLI::App* level = &app;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a.rfind("-", 0) == 0) {
+            const CLI::Option* o = level->get_option_no_throw(a.substr(0, a.find('=')));
+            if (o && o->get_type_size() > 0 && a.find('=') == std::string::npos)
+                ++i; // the option's value
+            continue;
+        }
+        CLI::App* next = nullptr;
+        for (CLI::App* c : level->get_subcommands({}))
+            if (c->check_name(a))
+                next = c;
+        if (!next) {
+            std::string names;
+            for (const CLI::App* c : level->get_subcommands({}))
+                names += (names.empty() ? "" : ", ") + c->get_name();
+            if (names.empty())
+                return {};
+            return fmt::format("unknown command '{}' for '{}'; use one of: {}", a, command_path(level), names);
+        }
+        level = next;
+    }
+    return {};
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -37,12 +77,15 @@ int main(int argc, char** argv) {
     bool quiet = false;
     int threads = 0;
     app.add_flag("-q,--quiet", quiet, "No progress bars or informational messages on stderr");
-    app.add_option("--threads", threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+    app.add_option("--threads", threads, "Worker threads (0: all cores)")
+        ->check(skybake::cli::integer_in(0, 4096))
+        ->capture_default_str();
     app.parse_complete_callback([&] {
         skybake::set_quiet(quiet);
         skybake::set_thread_count(threads);
     });
     skybake::cli::add_all_commands(app);
+    skybake::install_interrupt_handlers(); // long loops stop cleanly, leaving no output
 
     try {
         app.parse(argc, argv);
@@ -53,8 +96,21 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        print_error(skybake::format_error_line(e.what(), "command line; see --help"));
+        std::string what = e.what();
+        if (what.find("subcommand is required") != std::string::npos) {
+            const std::string unknown = unknown_command(app, argc, argv);
+            if (!unknown.empty())
+                what = unknown;
+        }
+        print_error(skybake::format_error_line(what, "command line; see --help"));
         return 2;
+    } catch (const skybake::cli::UsageError& e) {
+        const std::string where = e.where().empty() ? "command line" : e.where();
+        print_error(skybake::format_error_line(e.message(), where + "; see --help"));
+        return 2;
+    } catch (const skybake::Interrupted& e) {
+        print_error(e.what());
+        return 128 + e.signal();
     } catch (const skybake::Error& e) {
         print_error(e.what());
         return 1;

@@ -1,6 +1,7 @@
 // skybake mesh convert INPUT -o OUTPUT.glb|.ply [--ascii] [--json]
 #include "cli.h"
 #include "commands.h"
+#include "flags.h"
 #include "skybake/mesh.h"
 
 namespace skybake::cli {
@@ -13,6 +14,9 @@ struct MeshConvertOptions {
 };
 
 void run(const MeshConvertOptions& o) {
+    check_output_path(o.output, {".glb", ".ply"}, "--output");
+    if (o.ascii && lower_extension(o.output) != ".ply")
+        throw UsageError("--ascii applies to .ply outputs only", "--ascii");
     ImportReport rep;
     const Mesh mesh = load_mesh(o.input, &rep);
     ExportOptions e;

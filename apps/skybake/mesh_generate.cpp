@@ -1,8 +1,10 @@
 // skybake mesh generate --kind K --triangles N [--seed S] -o FILE [--ascii] [--json]
 #include <chrono>
+#include <cstdint>
 
 #include "cli.h"
 #include "commands.h"
+#include "flags.h"
 #include "skybake/mesh.h"
 
 namespace skybake::cli {
@@ -19,7 +21,10 @@ struct MeshGenerateOptions {
 
 void run(const MeshGenerateOptions& o) {
     ProceduralOptions p;
-    p.kind = parse_procedural_kind(o.kind);
+    p.kind = parse_flag("--kind", [&] { return parse_procedural_kind(o.kind); });
+    check_output_path(o.output, {".glb", ".ply"}, "--output");
+    if (o.ascii && lower_extension(o.output) != ".ply")
+        throw UsageError("--ascii applies to .ply outputs only", "--ascii");
     p.target_triangles = o.triangles;
     p.seed = o.seed;
     const auto t0 = std::chrono::steady_clock::now();
@@ -49,8 +54,12 @@ void add_mesh_generate(CLI::App& group) {
     for (const auto& k : procedural_kind_names())
         kinds += (kinds.empty() ? "" : "|") + k;
     sub->add_option("--kind", o->kind, kinds)->capture_default_str();
-    sub->add_option("--triangles", o->triangles, "Approximate triangle count (20 to 50,000,000)")->capture_default_str();
-    sub->add_option("--seed", o->seed, "Seed for terrain and city layouts")->capture_default_str();
+    sub->add_option("--triangles", o->triangles, "Approximate triangle count")
+        ->check(integer_in(20, 50'000'000))
+        ->capture_default_str();
+    sub->add_option("--seed", o->seed, "Seed for terrain and city layouts")
+        ->check(integer_in(0, INT64_MAX))
+        ->capture_default_str();
     sub->add_option("-o,--output", o->output, "Output mesh (.glb or .ply)")->required();
     sub->add_flag("--ascii", o->ascii, "Write PLY as ASCII instead of binary");
     add_json_flag(*sub, o->json);

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "cli.h"
+#include "flags.h"
 #include "skybake/neural.h"
 #include "skybake/sky.h"
 
@@ -16,25 +17,37 @@ struct AtmosphereFlags {
     std::string table_rule; // empty: the atmosphere's own
 
     void add(CLI::App& sub, bool allow_file = true) {
-        sub.add_option("--preset", preset, "Atmosphere preset: earth, paper, paper-dense");
+        sub.add_option("--preset", preset, "Atmosphere preset: earth (default), paper, paper-dense");
         if (allow_file)
             sub.add_option("--atmosphere", file, "Atmosphere JSON file (see `skybake sky preset`)");
-        sub.add_option("--paper-r", paper_r, "Seed's Rayleigh divisor r for --preset paper (default 10000)");
-        sub.add_option("--paper-m", paper_m, "Seed's Mie divisor m for --preset paper (default 10000)");
-        sub.add_option("--table-rule", table_rule, "Shell density rule of the tables: seed or refined");
+        sub.add_option("--paper-r", paper_r, "Seed's Rayleigh divisor r, for --preset paper only")
+            ->check(real_in(0.0, 1e12, "", End::Open))
+            ->capture_default_str();
+        sub.add_option("--paper-m", paper_m, "Seed's Mie divisor m, for --preset paper only")
+            ->check(real_in(0.0, 1e12, "", End::Open))
+            ->capture_default_str();
+        sub.add_option("--table-rule", table_rule,
+                       "Shell density rule of the tables: seed or refined (default: the atmosphere's own)");
     }
 
-    Atmosphere load() const {
+    Atmosphere load(const CLI::App& sub) const {
         if (!preset.empty() && !file.empty())
-            throw Error("give either --preset or --atmosphere, not both", "--preset/--atmosphere");
-        Atmosphere a = file.empty() ? atmosphere_preset(preset.empty() ? "earth" : preset, paper_r, paper_m)
+            throw UsageError("give either --preset or --atmosphere, not both", "--preset/--atmosphere");
+        if (preset != "paper")
+            for (const char* f : {"--paper-r", "--paper-m"})
+                refuse_if_given(sub, f, "to " + (file.empty() ? "preset " + (preset.empty() ? std::string("earth") : preset)
+                                                            : std::string("an atmosphere file")) +
+                                            " (only to --preset paper)");
+        Atmosphere a = file.empty() ? parse_flag("--preset", [&] {
+            return atmosphere_preset(preset.empty() ? "earth" : preset, paper_r, paper_m);
+        })
                                     : load_atmosphere(file);
         if (table_rule == "seed")
             a.table_rule = TableRule::Seed;
         else if (table_rule == "refined")
             a.table_rule = TableRule::Refined;
         else if (!table_rule.empty())
-            throw Error("unknown table rule '" + table_rule + "'; use seed or refined", "--table-rule");
+            throw UsageError("unknown table rule '" + table_rule + "'; use seed or refined", "--table-rule");
         return a;
     }
 };
@@ -51,10 +64,10 @@ struct ModelFlag {
     bool active() const { return !path.empty(); }
     NeuralSky load(const CLI::App& sub, const AtmosphereFlags& atm) const {
         if (!atm.preset.empty() || !atm.file.empty())
-            throw Error("a weights file carries its own atmosphere; drop --preset/--atmosphere", "--model");
-        for (const char* flag : {"--method", "--table-rule", "--steps", "--uniform-steps", "--shells", "--cosines"})
-            if (sub.get_option_no_throw(flag) && sub.get_option_no_throw(flag)->count() > 0)
-                throw Error(std::string(flag) + " does not apply to a neural sky", "--model");
+            throw UsageError("a weights file carries its own atmosphere; drop --preset/--atmosphere", "--model");
+        for (const char* flag : {"--method", "--table-rule", "--steps", "--uniform-steps", "--shells", "--cosines",
+                                 "--paper-r", "--paper-m"})
+            refuse_if_given(sub, flag, "to a neural sky (--model)");
         return load_neural_sky(path);
     }
 };
@@ -64,7 +77,7 @@ inline SkyMethod parse_sky_method(const std::string& s) {
         return SkyMethod::Tables;
     if (s == "exact")
         return SkyMethod::Exact;
-    throw Error("unknown method '" + s + "'; use tables or exact", "--method");
+    throw UsageError("unknown method '" + s + "'; use tables or exact", "--method");
 }
 
 } // namespace skybake::cli

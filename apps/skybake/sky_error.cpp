@@ -1,6 +1,10 @@
 // skybake sky error: accuracy of a trained neural sky against its sky model.
+#include <cstdint>
+#include <filesystem>
+
 #include "cli.h"
 #include "commands.h"
+#include "flags.h"
 #include "skybake/neural.h"
 
 namespace skybake::cli {
@@ -22,14 +26,28 @@ void add_sky_error(CLI::App& group) {
     };
     auto o = std::make_shared<Opts>();
     sub->add_option("--model", o->model, "Weights file (JSON from `skybake sky train`)")->required();
-    sub->add_option("--samples", o->e.samples, "Held-out random valid samples (default 100000)");
-    sub->add_option("--seed", o->e.seed, "Seed of the held-out samples (default: a stream not used in training)");
+    sub->add_option("--samples", o->e.samples, "Held-out random valid samples")
+        ->check(integer_in(1, 100'000'000))
+        ->capture_default_str();
+    sub->add_option("--seed", o->e.seed, "Seed of the held-out samples (default: a stream not used in training)")
+        ->check(integer_in(0, INT64_MAX));
     sub->add_flag("--no-views", o->no_views, "Skip the PSNR of the seed's views");
-    sub->add_option("--size", o->size, "Size of the rendered views WxH (default 240x160)");
-    sub->add_option("--views-dir", o->views_dir, "Also write the reference and neural views there as PNG");
+    sub->add_option("--size", o->size, "Size of the rendered views WxH")->capture_default_str();
+    sub->add_option("--views-dir", o->views_dir, "Also write the reference and neural views there as PNG (an "
+                                                 "existing folder)");
     add_json_flag(*sub, o->json);
-    sub->callback([o] {
-        parse_size(o->size, o->e.view_width, o->e.view_height, "--size");
+    sub->callback([o, sub] {
+        if (o->no_views)
+            for (const char* f : {"--size", "--views-dir"})
+                refuse_if_given(*sub, f, "with --no-views");
+        parse_flag("--size", [&] { parse_size(o->size, o->e.view_width, o->e.view_height, "--size"); });
+        if (!o->views_dir.empty()) { // an existing folder, or a new one in an existing folder
+            std::error_code ec;
+            if (std::filesystem::is_directory(o->views_dir, ec))
+                check_output_path((std::filesystem::path(o->views_dir) / "view.png").string(), {".png"}, "--views-dir");
+            else
+                check_output_path(o->views_dir, {}, "--views-dir");
+        }
         o->e.views = !o->no_views;
         o->e.views_dir = o->views_dir;
         const NeuralSky net = load_neural_sky(o->model);

@@ -1,9 +1,11 @@
 // skybake sky eval: the sky function I(cos α0, cos β0, cos θ0, ρ0) over a CSV file.
 #include <charconv>
 #include <chrono>
+#include <iostream>
 #include <sstream>
 
 #include "commands.h"
+#include "flags.h"
 #include "skybake/files.h"
 #include "sky_common.h"
 
@@ -30,53 +32,87 @@ bool parse_number(const std::string& s, double& out) {
     return r.ec == std::errc() && r.ptr == s.data() + s.size();
 }
 
-// Rows of "cos_view_zenith,cos_view_sun,cos_sun_zenith,density"; the first
-// line may be a header. Blank lines are skipped.
+std::vector<std::string> split_fields(const std::string& line) {
+    std::vector<std::string> fields;
+    std::size_t start = 0;
+    for (;;) {
+        const std::size_t comma = line.find(',', start);
+        fields.push_back(trim(std::string_view(line).substr(start, comma - start)));
+        if (comma == std::string::npos)
+            break;
+        start = comma + 1;
+    }
+    return fields;
+}
+
+constexpr const char* kColumns[4] = {"cos_view_zenith", "cos_view_sun", "cos_sun_zenith", "density"};
+
+// The CSV text of a file, or of standard input for "-".
+std::string read_input(const std::string& path) {
+    if (path != "-")
+        return read_file(path);
+    std::ostringstream s;
+    s << std::cin.rdbuf();
+    return s.str();
+}
+
+// Rows of the four columns of kColumns. The first line is a header naming
+// them, in any order (other names are an error), or the first row of numbers,
+// read in kColumns' order. Blank lines are skipped; no rows is an error.
 std::vector<SkySample> read_samples(const std::string& path) {
-    const std::string text = read_file(path);
+    const std::string name = path == "-" ? std::string("standard input") : path;
+    const std::string text = read_input(path);
     std::vector<SkySample> out;
     std::istringstream in(text);
     std::string line;
     int number = 0;
     bool first_content = true;
+    int column[4] = {0, 1, 2, 3}; // field index of each of kColumns
     while (std::getline(in, line)) {
         ++number;
-        const std::string where = fmt::format("line {} of {}", number, path);
+        const std::string where = fmt::format("line {} of {}", number, name);
         if (trim(line).empty())
             continue;
-        std::vector<std::string> fields;
-        std::size_t start = 0;
-        for (;;) {
-            const std::size_t comma = line.find(',', start);
-            fields.push_back(trim(std::string_view(line).substr(start, comma - start)));
-            if (comma == std::string::npos)
-                break;
-            start = comma + 1;
-        }
-        double v[4];
-        bool numeric = fields.size() == 4;
-        for (std::size_t i = 0; numeric && i < 4; ++i)
-            numeric = parse_number(fields[i], v[i]);
-        if (!numeric) {
-            double dummy;
-            if (first_content && !parse_number(fields[0], dummy)) { // a header
-                first_content = false;
-                continue;
+        const std::vector<std::string> fields = split_fields(line);
+        double dummy;
+        if (first_content && !parse_number(fields[0], dummy)) { // a header: columns by name
+            first_content = false;
+            for (int& c : column)
+                c = -1;
+            for (std::size_t i = 0; i < fields.size(); ++i) {
+                int k = 0;
+                while (k < 4 && fields[i] != kColumns[k])
+                    ++k;
+                if (k == 4)
+                    throw Error(fmt::format("unknown column '{}'; the columns are cos_view_zenith, cos_view_sun, "
+                                            "cos_sun_zenith and density, in any order",
+                                            fields[i]),
+                                where);
+                if (column[k] >= 0)
+                    throw Error(fmt::format("column '{}' appears twice", fields[i]), where);
+                column[k] = int(i);
             }
-            if (fields.size() != 4)
-                throw Error(fmt::format("expected 4 comma-separated numbers "
-                                        "(cos_view_zenith,cos_view_sun,cos_sun_zenith,density), got {} fields",
-                                        fields.size()),
-                            where);
-            throw Error("not a number: every field must be a decimal number", where);
+            for (int k = 0; k < 4; ++k)
+                if (column[k] < 0)
+                    throw Error(fmt::format("the header has no column '{}'", kColumns[k]), where);
+            continue;
         }
         first_content = false;
+        if (fields.size() != 4)
+            throw Error(fmt::format("expected 4 comma-separated numbers, got {} fields", fields.size()), where);
+        double v[4];
+        for (int k = 0; k < 4; ++k)
+            if (!parse_number(fields[std::size_t(column[k])], v[k]))
+                throw Error(fmt::format("{} '{}' is not a number", kColumns[k], fields[std::size_t(column[k])]),
+                            where);
         const SkySample s{float(v[0]), float(v[1]), float(v[2]), float(v[3])};
         check_sky_sample(s, where);
         if (!(v[3] > 0.0 && v[3] <= 1.0))
             throw Error(fmt::format("density {} is outside (0, 1]", v[3]), where);
         out.push_back(s);
     }
+    if (out.empty())
+        throw Error("no samples: the file has no rows of numbers", name);
     return out;
 }
 
@@ -94,27 +130,41 @@ void add_sky_eval(CLI::App& group) {
     auto o = std::make_shared<Opts>();
     o->atm.add(*sub);
     o->model.add(*sub);
-    sub->add_option("--method", o->method, "tables (the seed's sum over its tables, default) or exact");
-    sub->add_option("--input", o->input, "CSV rows: cos_view_zenith,cos_view_sun,cos_sun_zenith,density")->required();
-    sub->add_option("--output", o->output, "CSV rows r,g,b: radiance per unit sun irradiance, 1/sr")->required();
-    sub->add_option("--steps", o->steps, "Steps of the sum along each view ray (default 16)");
-    sub->add_option("--device", o->device, "cpu (default) or cuda (tables method and networks)");
+    sub->add_option("--method", o->method, "tables (the seed's sum over its tables) or exact")->capture_default_str();
+    sub->add_option("--input", o->input,
+                    "CSV with the columns cos_view_zenith,cos_view_sun,cos_sun_zenith,density (a header names them, "
+                    "in any order); - for standard input")
+        ->required();
+    sub->add_option("--output", o->output, "CSV rows r,g,b: radiance per unit sun irradiance, 1/sr; - for standard "
+                                           "output")
+        ->required();
+    sub->add_option("--steps", o->steps, "Steps of the sum along each view ray")
+        ->check(integer_in(1, 4096))
+        ->capture_default_str();
+    sub->add_option("--device", o->device, "cpu or cuda (tables method and networks)")->capture_default_str();
     sub->add_flag("--uniform-steps", o->uniform, "Use the seed's uniform step length instead of graded steps");
-    sub->add_option("--shells", o->shells, "Table rows n (default 256)");
-    sub->add_option("--cosines", o->cosines, "Table columns m (default 128)");
+    sub->add_option("--shells", o->shells, "Table rows n")->check(integer_in(2, 16384))->capture_default_str();
+    sub->add_option("--cosines", o->cosines, "Table columns m")->check(integer_in(2, 16384))->capture_default_str();
     add_json_flag(*sub, o->json);
     sub->callback([o, sub] {
+        if (o->json && o->output == "-")
+            throw UsageError("--json and --output - both write to standard output; write the CSV to a file",
+                             "--json");
+        check_output_path(o->output, {".csv"}, "--output");
         const bool neural = o->model.active();
         const NeuralSky net = neural ? o->model.load(*sub, o->atm) : NeuralSky{};
         const SkyMethod method = neural ? SkyMethod::Tables : parse_sky_method(o->method);
-        const Device device = parse_device(o->device);
+        const Device device = parse_flag("--device", [&] { return parse_device(o->device); });
         if (device == Device::Cuda) {
-            require_cuda_device("--device cuda");
             if (method == SkyMethod::Exact)
-                throw Error("the exact method runs on the CPU only; use --device cpu or --method tables",
-                            "--device cuda");
+                throw UsageError("the exact method runs on the CPU only; use --device cpu or --method tables",
+                                 "--device cuda");
+            require_cuda_device("--device cuda");
         }
-        const Atmosphere atm = neural ? net.atmosphere : o->atm.load();
+        if (method == SkyMethod::Exact)
+            for (const char* f : {"--steps", "--uniform-steps", "--shells", "--cosines"})
+                refuse_if_given(*sub, f, "to --method exact (it integrates to a tolerance, without tables)");
+        const Atmosphere atm = neural ? net.atmosphere : o->atm.load(*sub);
         const std::vector<SkySample> samples = read_samples(o->input);
         SkyModelOptions opts;
         opts.steps = o->steps;
@@ -131,11 +181,17 @@ void add_sky_eval(CLI::App& group) {
         else
             evaluate_sky(SkyModel(atm, opts), samples, out, method);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        write_stream_atomic(o->output, [&](std::ostream& f) {
+        const auto write_rows = [&](std::ostream& f) {
             f << "r,g,b\n";
             for (const glm::vec3& c : out)
                 f << fmt::format("{:.9g},{:.9g},{:.9g}\n", c.x, c.y, c.z);
-        });
+        };
+        if (o->output == "-") {
+            write_rows(std::cout);
+            std::cout.flush();
+        } else {
+            write_stream_atomic(o->output, write_rows);
+        }
         const std::string method_name = neural ? "neural" : o->method;
         info("{} samples, {} method on {}, {:.3f} s -> {}", samples.size(), method_name, o->device, seconds, o->output);
         if (o->json)

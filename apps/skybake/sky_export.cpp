@@ -1,6 +1,7 @@
 // skybake sky export: a trained neural sky as a GLSL, HLSL, CUDA or C function.
 #include "cli.h"
 #include "commands.h"
+#include "flags.h"
 #include "skybake/files.h"
 #include "skybake/neural.h"
 
@@ -16,12 +17,13 @@ void add_sky_export(CLI::App& group) {
     sub->add_option("model", o->model, "Weights file (JSON from `skybake sky train`)")->required();
     sub->add_option("--format", o->format, "glsl, hlsl, cuda or c")->required();
     sub->add_option("-o,--output", o->output, "Output source file")->required();
-    sub->add_option("--name", o->name, "Function name (default skybake_sky)");
+    sub->add_option("--name", o->name, "Function name (letters, digits and _)")->capture_default_str();
     add_json_flag(*sub, o->json);
     sub->callback([o] {
-        const ExportLanguage lang = parse_export_language(o->format);
+        const ExportLanguage lang = parse_flag("--format", [&] { return parse_export_language(o->format); });
+        check_output_path(o->output, {}, "--output");
         const NeuralSky net = load_neural_sky(o->model);
-        const std::string code = export_neural_sky(net, lang, o->name);
+        const std::string code = parse_flag("--name", [&] { return export_neural_sky(net, lang, o->name); });
         write_stream_atomic(o->output, [&](std::ostream& f) { f << code; });
         info("{} ({} weights, atmosphere '{}') -> {} function {}() in {}", net.topology.name(),
              net.topology.weight_count(), net.atmosphere.name, o->format, o->name, o->output);

@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "commands.h"
+#include "flags.h"
 #include "sky_common.h"
 
 namespace skybake::cli {
@@ -18,35 +19,46 @@ void add_sky_optical_length(CLI::App& group) {
     };
     auto o = std::make_shared<Opts>();
     o->atm.add(*sub);
-    sub->add_option("--density", o->density, "Relative density of the first component at the point, in (0, 1]")
+    sub->add_option("--density", o->density, "Relative density of the first component at the point")
+        ->check(real_in(0.0, 1.0, "", End::Open))
         ->required();
-    sub->add_option("--cos-zenith", o->cos_zenith, "Cosine of the ray's angle to the local vertical, [-1, 1]")
+    sub->add_option("--cos-zenith", o->cos_zenith, "Cosine of the ray's angle to the local vertical")
+        ->check(real_in(-1.0, 1.0, ""))
         ->required();
-    sub->add_option("--component", o->component, "Component index (default 0)");
-    sub->add_option("--method", o->method, "tables (the seed's tables) or exact (quadrature)");
-    sub->add_option("--shells", o->shells, "Table rows n (density steps), default 256");
-    sub->add_option("--cosines", o->cosines, "Table columns m (cosine steps), default 128");
+    sub->add_option("--component", o->component, "Component index")->check(integer_in(0, 3))->capture_default_str();
+    sub->add_option("--method", o->method, "tables (the seed's tables) or exact (quadrature)")->capture_default_str();
+    sub->add_option("--shells", o->shells, "Table rows n (density steps)")
+        ->check(integer_in(2, 16384))
+        ->capture_default_str();
+    sub->add_option("--cosines", o->cosines, "Table columns m (cosine steps)")
+        ->check(integer_in(2, 16384))
+        ->capture_default_str();
     add_json_flag(*sub, o->json);
-    sub->callback([o] {
-        const Atmosphere a = o->atm.load();
+    sub->callback([o, sub] {
+        const Atmosphere a = o->atm.load(*sub);
         a.validate();
-        if (!(std::isfinite(o->density) && o->density > 0.0 && o->density <= 1.0))
-            throw Error("density must be in (0, 1]", "--density");
-        if (!(std::isfinite(o->cos_zenith) && std::abs(o->cos_zenith) <= 1.0))
-            throw Error("the cosine must be in [-1, 1]", "--cos-zenith");
-        if (o->component < 0 || o->component >= int(a.components.size()))
-            throw Error("component index out of range: the atmosphere has " + std::to_string(a.components.size()) +
-                            " components",
-                        "--component");
-        if (o->shells < 2 || o->cosines < 2 || o->shells > 16384 || o->cosines > 16384)
-            throw Error("table resolution must be 2 to 16384", "--shells/--cosines");
+        if (o->component >= int(a.components.size()))
+            throw UsageError(fmt::format("component {} does not exist: the atmosphere has {} components (0 to {})",
+                                         o->component, a.components.size(), a.components.size() - 1),
+                             "--component");
         const SkyMethod method = parse_sky_method(o->method);
+        if (method == SkyMethod::Exact)
+            for (const char* f : {"--shells", "--cosines"})
+                refuse_if_given(*sub, f, "to --method exact");
         const double h = a.altitude_from_density(o->density) + 0.0; // no "-0"
-        double t;
+        // Whether the ray meets the ground is geometry, the same for both
+        // methods: r sin α < R0 on a downward ray. The tables only hold rays
+        // that reach the top (the seed's symmetry trick would give a length
+        // for a ray through the planet).
+        const double r = a.planet_radius_km + h, mu = o->cos_zenith;
+        const bool hits_ground = mu < 0.0 && r * r * (1.0 - mu * mu) < a.planet_radius_km * a.planet_radius_km;
+        double t = INFINITY;
         if (method == SkyMethod::Exact)
             t = optical_length_exact(a, o->component, h, o->cos_zenith);
-        else
+        else if (!hits_ground)
             t = OpticalLengthTables::build(a, {o->shells, o->cosines}).optical_length(o->component, h, o->cos_zenith);
+        if (hits_ground)
+            t = INFINITY;
         if (o->json) {
             print_json({{"atmosphere", a.name},
                         {"component", a.components[std::size_t(o->component)].name},
@@ -54,7 +66,7 @@ void add_sky_optical_length(CLI::App& group) {
                         {"altitude_km", h},
                         {"cos_zenith", o->cos_zenith},
                         {"method", o->method},
-                        {"hits_ground", std::isinf(t)},
+                        {"hits_ground", hits_ground},
                         {"optical_length_km", std::isinf(t) ? nlohmann::json(nullptr) : nlohmann::json(t)}});
             return;
         }

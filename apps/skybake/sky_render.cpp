@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "commands.h"
+#include "flags.h"
 #include "sky_common.h"
 
 namespace skybake::cli {
@@ -16,7 +17,7 @@ void add_sky_render(CLI::App& group) {
         ModelFlag model;
         SkyRenderSettings s;
         std::string view = "fisheye", size = "512x512", output, method = "tables", tone = "aces";
-        double exposure = NAN;
+        std::string exposure = "auto";
         bool has_azimuth = false, no_sun = false, json = false;
         int steps = 16;
         std::string ground = "lambert";
@@ -25,31 +26,48 @@ void add_sky_render(CLI::App& group) {
     auto o = std::make_shared<Opts>();
     o->atm.add(*sub);
     o->model.add(*sub);
-    sub->add_option("--altitude-km", o->s.altitude_km, "Observer altitude above the ground, km")->required();
-    sub->add_option("--sun-elevation-deg", o->s.sun_elevation_deg, "Sun elevation above the observer's horizon")
+    sub->add_option("--altitude-km", o->s.altitude_km, "Observer altitude above the ground, km")
+        ->check(real_in(0.0, 1e6, "km"))
         ->required();
-    sub->add_option("--sun-azimuth-deg", o->s.sun_azimuth_deg, "Sun azimuth, degrees from +x towards +y (default 0)");
-    sub->add_option("--view", o->view, "fisheye (upper hemisphere), panorama (360x180) or camera");
-    sub->add_option("--fov", o->s.fov_deg, "Camera: horizontal field of view, degrees (default 90)");
-    sub->add_option("--yaw", o->s.yaw_deg, "Camera: azimuth of the view centre, degrees (default 0)");
-    sub->add_option("--pitch", o->s.pitch_deg, "Camera: elevation of the view centre, degrees (default 0)");
-    sub->add_option("--size", o->size, "Image size WxH (default 512x512)");
+    sub->add_option("--sun-elevation-deg", o->s.sun_elevation_deg, "Sun elevation above the observer's horizon")
+        ->check(real_in(-90.0, 90.0, "degrees"))
+        ->required();
+    sub->add_option("--sun-azimuth-deg", o->s.sun_azimuth_deg, "Sun azimuth, degrees from +x towards +y")
+        ->check(real_in(-360.0, 360.0, "degrees"))
+        ->capture_default_str();
+    sub->add_option("--view", o->view, "fisheye (upper hemisphere), panorama (360x180) or camera")
+        ->capture_default_str();
+    sub->add_option("--fov", o->s.fov_deg, "Camera only: horizontal field of view, degrees")
+        ->check(real_in(0.0, 180.0, "degrees", End::Open, End::Open))
+        ->capture_default_str();
+    sub->add_option("--yaw", o->s.yaw_deg, "Camera only: azimuth of the view centre, degrees")
+        ->check(real_in(-360.0, 360.0, "degrees"))
+        ->capture_default_str();
+    sub->add_option("--pitch", o->s.pitch_deg, "Camera only: elevation of the view centre, degrees")
+        ->check(real_in(-90.0, 90.0, "degrees"))
+        ->capture_default_str();
+    sub->add_option("--size", o->size, "Image size WxH in pixels")->capture_default_str();
     sub->add_option("-o,--output", o->output, "Output image: .png (tone-mapped sRGB) or .exr (linear)")->required();
-    sub->add_option("--method", o->method, "tables (default) or exact (slow)");
-    sub->add_option("--steps", o->steps, "Steps of the sum per view ray (default 16)");
-    sub->add_option("--device", o->device, "cpu (default) or cuda (tables method and networks)");
-    sub->add_option("--exposure", o->exposure, "PNG exposure in stops (default: automatic)");
-    sub->add_option("--tone", o->tone, "PNG tone curve: aces, reinhard or clamp");
+    sub->add_option("--method", o->method, "tables or exact (slow)")->capture_default_str();
+    sub->add_option("--steps", o->steps, "Steps of the sum per view ray")
+        ->check(integer_in(1, 4096))
+        ->capture_default_str();
+    sub->add_option("--device", o->device, "cpu or cuda (tables method and networks)")->capture_default_str();
+    sub->add_option("--exposure", o->exposure, "PNG only: exposure in stops, or auto (the 98th percentile of "
+                                               "luminance maps to white)")
+        ->check(auto_or_real_in(-64.0, 64.0, "stops"))
+        ->capture_default_str();
+    sub->add_option("--tone", o->tone, "PNG only: tone curve, aces, reinhard or clamp")->capture_default_str();
     sub->add_flag("--no-sun", o->no_sun, "Do not draw the sun disc");
-    sub->add_option("--ground", o->ground, "Ground model: lambert (physical, default) or seed (the seed's b-scaled term)");
+    sub->add_option("--ground", o->ground, "Ground model: lambert (physical) or seed (the seed's b-scaled term)")
+        ->capture_default_str();
     add_json_flag(*sub, o->json);
     sub->callback([o, sub] {
+        check_output_path(o->output, {".png", ".exr"}, "--output");
         const bool neural = o->model.active();
         const NeuralSky net = neural ? o->model.load(*sub, o->atm) : NeuralSky{};
-        const Atmosphere atm = neural ? net.atmosphere : o->atm.load();
-        const Device device = parse_device(o->device);
-        if (device == Device::Cuda)
-            require_cuda_device("--device cuda");
+        const Atmosphere atm = neural ? net.atmosphere : o->atm.load(*sub);
+        const Device device = parse_flag("--device", [&] { return parse_device(o->device); });
         if (o->view == "fisheye")
             o->s.view = SkyView::Fisheye;
         else if (o->view == "panorama")
@@ -57,18 +75,29 @@ void add_sky_render(CLI::App& group) {
         else if (o->view == "camera")
             o->s.view = SkyView::Camera;
         else
-            throw Error("unknown view '" + o->view + "'; use fisheye, panorama or camera", "--view");
-        parse_size(o->size, o->s.width, o->s.height, "--size");
+            throw UsageError("unknown view '" + o->view + "'; use fisheye, panorama or camera", "--view");
+        if (o->s.view != SkyView::Camera)
+            for (const char* f : {"--fov", "--yaw", "--pitch"})
+                refuse_if_given(*sub, f, "to --view " + o->view + " (camera only)");
+        parse_flag("--size", [&] { parse_size(o->size, o->s.width, o->s.height, "--size"); });
         o->s.method = neural ? SkyMethod::Tables : parse_sky_method(o->method);
+        if (o->s.method == SkyMethod::Exact) {
+            refuse_if_given(*sub, "--steps", "to --method exact");
+            if (device == Device::Cuda)
+                throw UsageError("the exact method runs on the CPU only; use --device cpu or --method tables",
+                                 "--device cuda");
+        }
         o->s.sun_disc = !o->no_sun;
         if (o->ground != "lambert" && o->ground != "seed")
-            throw Error("unknown ground model '" + o->ground + "'; use lambert or seed", "--ground");
+            throw UsageError("unknown ground model '" + o->ground + "'; use lambert or seed", "--ground");
         o->s.seed_ground = o->ground == "seed";
         ToneMap tm;
-        tm.curve = parse_tone_curve(o->tone);
-        const std::string ext = std::filesystem::path(o->output).extension().string();
-        if (ext != ".png" && ext != ".exr")
-            throw Error("the output must end in .png or .exr", o->output);
+        tm.curve = parse_flag("--tone", [&] { return parse_tone_curve(o->tone); });
+        if (lower_extension(o->output) == ".exr")
+            for (const char* f : {"--exposure", "--tone"})
+                refuse_if_given(*sub, f, "to an .exr output (linear radiance)");
+        if (device == Device::Cuda)
+            require_cuda_device("--device cuda");
         SkyModelOptions opts;
         opts.steps = o->steps;
         const auto t0 = std::chrono::steady_clock::now();
@@ -77,7 +106,7 @@ void add_sky_render(CLI::App& group) {
         const Image img = neural ? (gpu ? render_neural_sky_cuda(net, model, o->s) : render_neural_sky(net, model, o->s))
                                  : (gpu ? render_sky_cuda(model, o->s) : render_sky(model, o->s));
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        tm.exposure_ev = std::isfinite(o->exposure) ? float(o->exposure) : float(auto_exposure_ev(img));
+        tm.exposure_ev = o->exposure == "auto" ? float(auto_exposure_ev(img)) : std::stof(o->exposure);
         save_image(o->output, img, tm);
         info("{}x{} {} view from {} km, sun at {} deg: {:.2f} s -> {} (exposure {:+.2f} EV)", o->s.width, o->s.height,
              o->view, o->s.altitude_km, o->s.sun_elevation_deg, seconds, o->output, tm.exposure_ev);

@@ -1,7 +1,11 @@
 // skybake sky train: fit the seed's perceptron (or a larger one) to the sky model.
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "commands.h"
+#include "flags.h"
+#include "skybake/files.h"
 #include "sky_common.h"
 #include "skybake/neural.h"
 
@@ -19,57 +23,86 @@ void add_sky_train(CLI::App& group) {
     };
     auto o = std::make_shared<Opts>();
     o->atm.add(*sub);
-    sub->add_option("--samples", o->t.samples, "Training samples (default 800000)");
+    sub->add_option("--samples", o->t.samples, "Training samples")
+        ->check(integer_in(16, 2'147'483'647))
+        ->capture_default_str();
     sub->add_option("--topology", o->topology,
-                    "paper (4 x 4-8-4-1, 324 weights), independent:W1xW2... or shared:W1xW2... (default paper)");
+                    "paper (4 x 4-8-4-1, 324 weights), independent:W1xW2... or shared:W1xW2...")
+        ->capture_default_str();
     sub->add_option("--brightness", o->brightness,
-                    "Brightness output M: log (default; relative accuracy) or seed (linear, as printed)");
-    sub->add_option("--log-range", o->log_range_decades, "Decades of N/max{N} the log brightness covers (default 6)");
-    sub->add_option("--epochs", o->t.adam_epochs, "Adam epochs (default 60)");
-    sub->add_option("--lm-iterations", o->t.lm_iterations, "Levenberg-Marquardt iterations after Adam (default 30)");
-    sub->add_option("--lm-samples", o->t.lm_samples, "Samples in the LM least squares (default: automatic)");
-    sub->add_option("--batch", o->t.batch, "Adam mini-batch (default 1024)");
-    sub->add_option("--learning-rate", o->t.learning_rate, "Adam step size of the first epoch (default 0.02)");
-    sub->add_option("--learning-rate-final", o->t.learning_rate_final, "Adam step size of the last epoch (default 0.0005)");
-    sub->add_option("--heldout", o->t.heldout_samples, "Held-out samples for the learning curve (default 20000)");
-    sub->add_option("--seed", o->t.seed, "Random seed (default 1)");
-    sub->add_option("--steps", o->steps, "Steps of the sky model's sum for the targets (default 16)");
-    sub->add_option("--device", o->device, "Where the training targets are computed: cpu (default) or cuda");
+                    "Brightness output M: log (relative accuracy) or seed (linear, as printed)")
+        ->capture_default_str();
+    sub->add_option("--log-range", o->log_range_decades, "Decades of N/max{N} the log brightness covers")
+        ->check(real_in(0.0, 80.0, "decades", End::Open))
+        ->capture_default_str();
+    sub->add_option("--epochs", o->t.adam_epochs, "Adam epochs")->check(integer_in(0, 100'000))->capture_default_str();
+    sub->add_option("--lm-iterations", o->t.lm_iterations, "Levenberg-Marquardt iterations after Adam")
+        ->check(integer_in(0, 10'000))
+        ->capture_default_str();
+    sub->add_option("--lm-samples", o->t.lm_samples, "Samples in the LM least squares (0: automatic)")
+        ->check(integer_in(0, 100'000'000))
+        ->capture_default_str();
+    sub->add_option("--batch", o->t.batch, "Adam mini-batch, in samples (default 1024, or --samples if fewer)")
+        ->check(integer_in(1, 100'000'000));
+    sub->add_option("--learning-rate", o->t.learning_rate, "Adam step size of the first epoch")
+        ->check(real_in(0.0, 10.0, "", End::Open))
+        ->capture_default_str();
+    sub->add_option("--learning-rate-final", o->t.learning_rate_final, "Adam step size of the last epoch")
+        ->check(real_in(0.0, 10.0, "", End::Open))
+        ->capture_default_str();
+    sub->add_option("--heldout", o->t.heldout_samples, "Held-out samples for the learning curve")
+        ->check(integer_in(1, 100'000'000))
+        ->capture_default_str();
+    sub->add_option("--seed", o->t.seed, "Random seed")->check(integer_in(0, INT64_MAX))->capture_default_str();
+    sub->add_option("--steps", o->steps, "Steps of the sky model's sum for the targets")
+        ->check(integer_in(1, 4096))
+        ->capture_default_str();
+    sub->add_option("--device", o->device, "Where the training targets are computed: cpu or cuda")
+        ->capture_default_str();
     sub->add_option("--curve", o->curve, "Write the learning curve as CSV");
     sub->add_option("--chart", o->chart, "Write the learning curve as a PNG chart");
     sub->add_option("-o,--output", o->output, "Weights file (JSON)")->required();
     add_json_flag(*sub, o->json);
-    sub->callback([o] {
-        o->t.device = parse_device(o->device);
+    sub->callback([o, sub] {
+        check_output_path(o->output, {".json"}, "--output");
+        if (!o->curve.empty())
+            check_output_path(o->curve, {".csv"}, "--curve");
+        if (!o->chart.empty())
+            check_output_path(o->chart, {".png"}, "--chart");
+        for (const std::string* p : {&o->curve, &o->chart})
+            if (!p->empty() && *p == o->output)
+                throw UsageError("the curve and chart files must differ from the weights file", *p);
+        o->t.device = parse_flag("--device", [&] { return parse_device(o->device); });
         if (o->t.device == Device::Cuda)
             require_cuda_device("--device cuda");
-        const Atmosphere atm = o->atm.load();
-        o->t.topology = parse_topology(o->topology);
+        const Atmosphere atm = o->atm.load(*sub);
+        o->t.topology = parse_flag("--topology", [&] { return parse_topology(o->topology); });
         if (o->brightness == "log")
             o->t.brightness = BrightnessEncoding::Log;
         else if (o->brightness == "seed")
             o->t.brightness = BrightnessEncoding::Seed;
         else
-            throw Error("unknown brightness encoding '" + o->brightness + "'; use log or seed", "--brightness");
-        if (!(o->log_range_decades > 0.0 && o->log_range_decades <= 80.0))
-            throw Error("the log range must be 0 to 80 decades", "--log-range");
+            throw UsageError("unknown brightness encoding '" + o->brightness + "'; use log or seed", "--brightness");
         o->t.log_range = o->log_range_decades * std::log(10.0);
-        for (const std::string* p : {&o->curve, &o->chart})
-            if (!p->empty() && *p == o->output)
-                throw Error("the curve and chart files must differ from the weights file", *p);
-        if (!o->chart.empty() && std::filesystem::path(o->chart).extension() != ".png")
-            throw Error("the chart must be a .png file", o->chart);
+        if (!given(*sub, "--batch"))
+            o->t.batch = std::min<std::size_t>(o->t.batch, o->t.samples);
+        else if (o->t.batch > o->t.samples)
+            throw UsageError(fmt::format("the mini-batch of {} samples is larger than --samples {}", o->t.batch,
+                                         o->t.samples),
+                             "--batch");
         SkyModelOptions opts;
         opts.steps = o->steps;
         const SkyModel model(atm, opts);
         std::vector<LearningCurvePoint> curve;
         const NeuralSky net = train_neural_sky(model, o->t, &curve);
-        save_neural_sky(o->output, net);
+        OutputSet files; // all three, or none
+        save_neural_sky(files.stage(o->output), net);
         if (!o->curve.empty())
-            save_learning_curve_csv(o->curve, curve);
+            save_learning_curve_csv(files.stage(o->curve), curve);
         if (!o->chart.empty())
-            save_learning_curve_png(o->chart, curve,
+            save_learning_curve_png(files.stage(o->chart), curve,
                                     fmt::format("{} on {}, {} samples", net.topology.name(), atm.name, o->t.samples));
+        files.commit();
         const NeuralTrainingSummary& s = net.training;
         info("trained {} ({} weights) on {} samples of '{}' in {:.1f} s ({} threads): held-out RMS {:.4g}, "
              "mean relative error {:.3g}% -> {}",
@@ -90,8 +123,8 @@ void add_sky_train(CLI::App& group) {
                         {"heldout_rms", s.heldout_rms},
                         {"heldout_mean_relative", s.heldout_mean_relative},
                         {"output", o->output},
-                        {"curve", o->curve},
-                        {"chart", o->chart}});
+                        {"curve", o->curve.empty() ? nlohmann::json(nullptr) : nlohmann::json(o->curve)},
+                        {"chart", o->chart.empty() ? nlohmann::json(nullptr) : nlohmann::json(o->chart)}});
     });
 }
 

@@ -3,6 +3,7 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "flags.h"
 #include "skybake/files.h"
 #include "skybake/sphere.h"
 
@@ -17,7 +18,8 @@ struct ExportOptions {
 };
 
 void run(const ExportOptions& o) {
-    const SphereRule r = parse_rule(o.rule);
+    const SphereRule r = parse_flag("rule", [&] { return parse_rule(o.rule); });
+    check_output_path(o.output, {".csv"}, "--output");
     write_stream_atomic(o.output, [&](std::ostream& out) {
         out << "x,y,z,w\n";
         for (std::size_t k = 0; k < r.size(); ++k)
@@ -25,7 +27,7 @@ void run(const ExportOptions& o) {
                                r.weights[k]);
     });
     if (o.json) {
-        print_json({{"spec", r.spec}, {"points", r.size()}, {"precision", r.precision}, {"file", o.output}});
+        print_json({{"spec", r.spec}, {"points", r.size()}, {"precision", r.precision}, {"output", o.output}});
         return;
     }
     info("wrote {} points of {} to {}", r.size(), r.spec, o.output);

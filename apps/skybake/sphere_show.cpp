@@ -3,6 +3,7 @@
 
 #include "cli.h"
 #include "commands.h"
+#include "flags.h"
 #include "skybake/sphere.h"
 
 namespace skybake::cli {
@@ -16,7 +17,7 @@ struct ShowOptions {
 };
 
 void run(const ShowOptions& o) {
-    const SphereRule r = parse_rule(o.rule);
+    const SphereRule r = parse_flag("rule", [&] { return parse_rule(o.rule); });
     double sum = 0.0, lo = 1e300, hi = -1e300;
     for (double w : r.weights) {
         sum += w;
@@ -74,7 +75,7 @@ void add_sphere_show(CLI::App& group) {
     sub->add_option("rule", o->rule, "Rule spec, e.g. lebedev:5810, design:t21, phong:a=32,n=8 (see 'sphere list')")
         ->required();
     sub->add_option("--limit", o->limit, "Rows of points to print (default: 20, all with --json)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(integer_in(0, 100'000'000));
     add_json_flag(*sub, o->json);
     sub->callback([o] { run(*o); });
 }

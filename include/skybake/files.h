@@ -9,6 +9,8 @@
 #include <functional>
 #include <iosfwd>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace skybake {
 
@@ -21,6 +23,30 @@ void write_file_atomic(const std::filesystem::path& target,
 // Same, for writers that produce a binary stream.
 void write_stream_atomic(const std::filesystem::path& target,
                          const std::function<void(std::ostream& out)>& write);
+
+// Several output files committed as one: each is written under a staging
+// name beside its target (same folder, same extension, so any writer that
+// picks its format by extension works), and commit() renames them all into
+// place once every one is complete. A set destroyed before commit() removes
+// what it staged, so a failure in the third file leaves the first two
+// targets untouched.
+class OutputSet {
+public:
+    OutputSet() = default;
+    OutputSet(const OutputSet&) = delete;
+    OutputSet& operator=(const OutputSet&) = delete;
+    ~OutputSet();
+
+    // The path to write `target`'s contents to. Throws skybake::Error if the
+    // target's folder does not exist or the target is a folder.
+    std::filesystem::path stage(const std::filesystem::path& target);
+    // Renames every staged file onto its target. Throws skybake::Error naming
+    // the target if one cannot be renamed (the others are still committed).
+    void commit();
+
+private:
+    std::vector<std::pair<std::filesystem::path, std::filesystem::path>> staged_; // staging path, target
+};
 
 // Reads a whole file; throws skybake::Error if it is missing, unreadable or
 // larger than max_bytes.

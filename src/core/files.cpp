@@ -42,6 +42,11 @@ void write_file_atomic(const fs::path& target, const std::function<void(const fs
     std::error_code ec;
     try {
         write(tmp);
+    } catch (const Error& e) {
+        fs::remove(tmp, ec);
+        if (e.where() == tmp.string()) // the temporary's name means nothing to the user
+            throw Error(e.message(), target.string());
+        throw;
     } catch (...) {
         fs::remove(tmp, ec);
         throw;
@@ -58,13 +63,47 @@ void write_file_atomic(const fs::path& target, const std::function<void(const fs
 void write_stream_atomic(const fs::path& target, const std::function<void(std::ostream&)>& write) {
     write_file_atomic(target, [&](const fs::path& tmp) {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out)
-            throw Error(fmt::format("cannot create file: {}", std::strerror(errno)), tmp.string());
+        if (!out) // named after the target: the temporary's name means nothing to the user
+            throw Error(fmt::format("cannot create file: {}", std::strerror(errno)), target.string());
         write(out);
         out.flush();
         if (!out)
             throw Error("write failed (disk full?)", target.string());
     });
+}
+
+OutputSet::~OutputSet() {
+    std::error_code ec;
+    for (const auto& [staging, target] : staged_)
+        fs::remove(staging, ec);
+}
+
+fs::path OutputSet::stage(const fs::path& target) {
+    check_target(target);
+    static std::atomic<unsigned> counter{0};
+    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    const fs::path staging =
+        dir / fmt::format(".{}.staged-{}-{}{}", target.stem().string(), ::getpid(), counter++, target.extension().string());
+    staged_.emplace_back(staging, target);
+    return staging;
+}
+
+void OutputSet::commit() {
+    std::error_code ec;
+    for (const auto& [staging, target] : staged_)
+        if (!fs::exists(staging, ec))
+            throw Error("a staged output was never written", target.string());
+    std::string failed, failed_target;
+    for (const auto& [staging, target] : staged_) {
+        fs::rename(staging, target, ec);
+        if (ec && failed.empty()) {
+            failed = fmt::format("cannot rename output into place: {}", ec.message());
+            failed_target = target.string();
+        }
+    }
+    if (!failed.empty())
+        throw Error(failed, failed_target);
+    staged_.clear();
 }
 
 std::string read_file(const fs::path& path, std::uint64_t max_bytes) {

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include "skybake/core.h"
+#include "skybake/interrupt.h"
 
 namespace skybake {
 
@@ -15,6 +16,7 @@ Progress::Progress(std::string label, std::uint64_t total)
 Progress::~Progress() { finish(); }
 
 void Progress::advance(std::uint64_t n) {
+    check_interrupted();
     const std::uint64_t done = done_.fetch_add(n) + n;
     if (!enabled_)
         return;
@@ -24,6 +26,11 @@ void Progress::advance(std::uint64_t n) {
         return;
     last_draw_ = now;
     draw(done, false);
+}
+
+void Progress::set_status(std::string status) {
+    std::lock_guard lock(mutex_);
+    status_ = std::move(status);
 }
 
 void Progress::finish() {
@@ -44,7 +51,19 @@ void Progress::draw(std::uint64_t done, bool final) {
     for (int i = 0; i < width; ++i)
         bar[i] = i < filled ? '#' : '.';
     bar[width] = 0;
-    std::fprintf(stderr, "\r%s [%s] %5.1f%% %6.1fs", label_.c_str(), bar, frac * 100.0, secs);
+    const double rate = secs > 0.0 ? double(done) / secs : 0.0;
+    const char* unit = "";
+    double shown = rate;
+    for (const char* u : {"k", "M", "G"})
+        if (shown >= 1000.0) {
+            shown /= 1000.0;
+            unit = u;
+        }
+    char left[32] = "";
+    if (!final && frac > 0.0 && frac < 1.0)
+        std::snprintf(left, sizeof left, ", %.0fs left", secs * (1.0 - frac) / frac);
+    std::fprintf(stderr, "\r%s [%s] %5.1f%% %6.1f%s/s %6.1fs%s%s%s\x1b[K", label_.c_str(), bar, frac * 100.0, shown,
+                 unit, secs, left, status_.empty() ? "" : "  ", status_.c_str());
     if (final)
         std::fprintf(stderr, "\n");
     std::fflush(stderr);

@@ -12,12 +12,14 @@
 #include <cstring>
 #include <sys/resource.h>
 #include <sys/wait.h>
+#include <sys/prctl.h>
 #include <unistd.h>
 
 #include <fmt/format.h>
 
 #include "io/mesh_internal.h"
 #include "skybake/error.h"
+#include "skybake/interrupt.h"
 
 #if defined(__SANITIZE_ADDRESS__)
 #define SKYBAKE_ASAN 1
@@ -149,12 +151,17 @@ bool write_all(int fd, const std::string& s) {
     return true;
 }
 
-[[noreturn]] void child_main(int fd, const std::function<RawImport()>& parse, const ImportLimits& limits) {
+[[noreturn]] void child_main(int fd, const std::function<RawImport()>& parse, const ImportLimits& limits,
+                             pid_t parent) {
     // Die plainly on a fault: handlers inherited from the parent (a crash
     // reporter, a sanitizer, a fuzzer) must not run in the child; the parent
     // reports the signal as one error line.
-    for (int sig : {SIGALRM, SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT})
+    for (int sig : {SIGALRM, SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT, SIGINT, SIGTERM})
         ::signal(sig, SIG_DFL);
+    // Die with the parent: a killed CLI must not leave a parser running.
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent)
+        _exit(4); // the parent died before prctl took effect
     ::alarm(limits.parser_timeout_s > 0 ? limits.parser_timeout_s : 0);
 #if !defined(SKYBAKE_ASAN) // ASan reserves terabytes of address space for its shadow
     if (limits.parser_memory_bytes > 0) {
@@ -194,6 +201,7 @@ RawImport run_isolated(const std::function<RawImport()>& parse, const std::strin
     int fds[2];
     if (::pipe(fds) != 0)
         throw Error(fmt::format("cannot create a pipe: {}", std::strerror(errno)), where);
+    const pid_t parent = ::getpid();
     const pid_t pid = ::fork();
     if (pid < 0) {
         ::close(fds[0]);
@@ -202,15 +210,24 @@ RawImport run_isolated(const std::function<RawImport()>& parse, const std::strin
     }
     if (pid == 0) {
         ::close(fds[0]);
-        child_main(fds[1], parse, limits);
+        child_main(fds[1], parse, limits, parent);
     }
     ::close(fds[1]);
     std::string buf;
     char chunk[1 << 16];
     for (;;) {
         const ssize_t n = ::read(fds[0], chunk, sizeof(chunk));
-        if (n < 0 && errno == EINTR)
+        if (n < 0 && errno == EINTR) {
+            if (interrupt_signal() != 0) { // SIGINT/SIGTERM: stop the parser, then report
+                ::kill(pid, SIGKILL);
+                ::close(fds[0]);
+                int status = 0;
+                while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+                }
+                check_interrupted();
+            }
             continue;
+        }
         if (n <= 0)
             break;
         buf.append(chunk, std::size_t(n));

@@ -225,7 +225,16 @@ Mesh load_mesh(const std::filesystem::path& path, ImportReport* report, const Im
         in.read(head.data(), std::streamsize(head.size()));
         io::precheck_for_assimp(ext, head.data(), std::size_t(size), where, limits);
     }
-    return io::finish_import(io::read_assimp(nullptr, 0, ext, where, limits, &path), where, limits, report);
+    try {
+        return io::finish_import(io::read_assimp(nullptr, 0, ext, where, limits, &path), where, limits, report);
+    } catch (const Error& e) {
+        // Assimp's OBJ reader turns "v nan 1 0" into (nan, nan, nan) and may
+        // renumber vertices: name the file's own line instead.
+        if (ext == "obj" && e.message().find("non-finite coordinate") != std::string::npos)
+            if (const std::string line = io::first_non_finite_obj_vertex(path); !line.empty())
+                throw Error(line, where);
+        throw;
+    }
 }
 
 Mesh load_mesh_from_memory(const void* data, std::size_t size, const std::string& extension_hint,

@@ -2,6 +2,10 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
 #include <string_view>
 
 #include <assimp/Importer.hpp>
@@ -84,6 +88,30 @@ struct Flattener {
 };
 
 } // namespace
+
+std::string first_non_finite_obj_vertex(const std::filesystem::path& path) {
+    std::ifstream in(path);
+    std::string line;
+    std::size_t number = 0, vertex = 0;
+    while (std::getline(in, line)) {
+        ++number;
+        if (line.size() < 2 || line[0] != 'v' || !std::isspace(static_cast<unsigned char>(line[1])))
+            continue;
+        ++vertex;
+        std::istringstream fields(line.substr(2));
+        std::string token;
+        for (int k = 0; k < 3 && fields >> token; ++k) {
+            const double x = std::strtod(token.c_str(), nullptr);
+            if (!std::isfinite(x)) {
+                if (line.size() > 80)
+                    line = line.substr(0, 80) + "...";
+                return fmt::format("line {}: vertex {} has a non-finite coordinate '{}' ({})", number, vertex, token,
+                                   line);
+            }
+        }
+    }
+    return {};
+}
 
 void precheck_for_assimp(const std::string& ext, const void* data, std::size_t size, const std::string& where,
                          const ImportLimits& limits) {

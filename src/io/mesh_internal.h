@@ -34,6 +34,11 @@ RawImport run_isolated(const std::function<RawImport()>& parse, const std::strin
 void precheck_for_assimp(const std::string& ext, const void* data, std::size_t size, const std::string& where,
                          const ImportLimits& limits);
 
+// "line 3: vertex 2 has a non-finite coordinate 'nan' (v nan 1 0)" for the
+// first "v" line of an OBJ file with a NaN or infinite coordinate; empty if
+// there is none (or the file cannot be read).
+std::string first_non_finite_obj_vertex(const std::filesystem::path& path);
+
 // Validates a raw import and brings it to the Mesh invariants: throws on
 // emptiness, non-finite coordinates and out-of-range indices; drops
 // degenerate triangles; computes normals when any are missing or unusable.

@@ -206,16 +206,23 @@ NeuralSky neural_sky_from_json(std::string_view text, const std::string& where) 
         net.encoding.log_range = number(enc, "log_range", where + ": encoding");
 
         const json& w = field(j, "weights", where);
-        if (!w.is_array() || int(w.size()) != net.topology.subnet_count())
-            throw Error(fmt::format("'weights' must hold {} sub-network arrays for topology {}",
-                                    net.topology.subnet_count(), net.topology.name()),
+        if (!w.is_array())
+            throw Error(fmt::format("'weights' is {}, not an array of {} sub-network arrays", w.type_name(),
+                                    net.topology.subnet_count()),
+                        where);
+        if (int(w.size()) != net.topology.subnet_count())
+            throw Error(fmt::format("'weights' must hold {} sub-network arrays for topology {}, holds {}",
+                                    net.topology.subnet_count(), net.topology.name(), w.size()),
                         where);
         for (std::size_t s = 0; s < w.size(); ++s) {
-            if (!w[s].is_array() || int(w[s].size()) != net.topology.subnet_weight_count())
+            if (!w[s].is_array())
+                throw Error(fmt::format("sub-network {} is {}, not an array of {} weights", s, w[s].type_name(),
+                                        net.topology.subnet_weight_count()),
+                            where);
+            if (int(w[s].size()) != net.topology.subnet_weight_count())
                 throw Error(fmt::format("sub-network {} must have {} weights for topology {}, has {}; the file is "
                                         "corrupt or does not match its topology",
-                                        s, net.topology.subnet_weight_count(), net.topology.name(),
-                                        w[s].is_array() ? w[s].size() : 0),
+                                        s, net.topology.subnet_weight_count(), net.topology.name(), w[s].size()),
                             where);
             for (const json& v : w[s]) {
                 if (!v.is_number())

@@ -272,8 +272,10 @@ NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, s
         net.training.heldout_mean_relative = h.mean_relative;
         if (curve)
             curve->push_back({epoch, phase, train_rms, h.rms, h.mean_relative, elapsed()});
-        if (progress)
+        if (progress) {
+            progress->set_status(fmt::format("{} loss {:.4g}, held-out RMS {:.4g}", phase, train_rms, h.rms));
             progress->advance();
+        }
     };
 
     // --- Adam --------------------------------------------------------------------

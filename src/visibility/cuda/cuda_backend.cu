@@ -288,7 +288,8 @@ struct CudaBackend::Impl {
 
 CudaBackend::CudaBackend() : impl_(std::make_unique<Impl>()) {
     if (cuda_device_count() == 0)
-        throw Error("no usable CUDA device (" + cuda_device_problem() + "); use --backend embree", "--backend cuda");
+        throw Error("no usable CUDA device (" + cuda_device_problem() + "); bake on the CPU (--device cpu)",
+                    "--device cuda");
     SKYBAKE_CUDA_CHECK(cudaSetDevice(0));
     impl_->device = cuda_device_name();
 }
@@ -321,7 +322,7 @@ void CudaBackend::set_mesh(const Mesh& mesh, BackFaces back_faces) {
     if (need > have)
         throw Error("the mesh's BVH (" + std::to_string(mesh.triangle_count()) + " triangles) needs " + mib(need) +
                         " of GPU memory, but only " + mib(have) + " is available on " + m.device +
-                        "; use --backend embree, or a GPU with more memory",
+                        "; use --device cpu, or a GPU with more memory",
                     "--backend cuda");
     m.nodes.upload(m.bvh.nodes.data(), m.bvh.nodes.size());
     m.triangles.upload(m.bvh.triangles.data(), m.bvh.triangles.size());
@@ -370,7 +371,7 @@ void CudaBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
     const std::uint64_t fit = budget > rule_bytes ? (budget - rule_bytes) / (2 * per_vertex) : 0;
     if (fit == 0)
         throw Error("not enough GPU memory on " + m.device + " for even one vertex of the bake (" + mib(budget) +
-                        " available after the BVH); use --backend embree",
+                        " available after the BVH); use --device cpu",
                     "--backend cuda");
     const std::uint64_t grid = (std::uint64_t(0x7fffffff) * kBlock) / slots; // a launch has < 2^31 blocks
     const auto chunk = std::uint32_t(std::clamp<std::uint64_t>(std::min({work, fit, grid}), 1, std::max(n, 1u)));
@@ -390,7 +391,7 @@ void CudaBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptio
     } catch (const Error&) {
         throw Error("cannot allocate the bake's buffers on " + m.device + " (" + std::to_string(nslots) +
                         " chunks of " + std::to_string(chunk) + " vertices, " +
-                        mib(std::uint64_t(nslots) * chunk * per_vertex) + "); free GPU memory, or use --backend embree",
+                        mib(std::uint64_t(nslots) * chunk * per_vertex) + "); free GPU memory, or use --device cpu",
                     "--backend cuda");
     }
 

@@ -8,7 +8,7 @@ namespace skybake::visibility {
 
 std::unique_ptr<VisibilityBackend> make_cuda_backend() {
     throw Error("this build has no CUDA support; rebuild with the CUDA toolkit installed (nvcc on PATH or in "
-                "/usr/local/cuda), or use --backend embree",
+                "/usr/local/cuda), or use --device cpu",
                 "--backend cuda");
 }
 

@@ -1,0 +1,156 @@
+#include "flags.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+namespace skybake::cli {
+
+namespace fs = std::filesystem;
+
+std::string readable(double x) {
+    if (std::isnan(x))
+        return "nan";
+    if (std::isinf(x))
+        return x > 0 ? "inf" : "-inf";
+    if (x == std::floor(x) && std::abs(x) < 1e15)
+        return fmt::format("{:.0f}", x);
+    return fmt::format("{:.6g}", x);
+}
+
+namespace {
+
+std::string range_text(double lo, double hi, End lo_end, End hi_end, const std::string& unit) {
+    std::string r;
+    if (std::isinf(lo) && std::isinf(hi))
+        r = "a finite number";
+    else if (std::isinf(hi))
+        r = fmt::format("a finite number {} {}", lo_end == End::Open ? ">" : "≥", readable(lo));
+    else if (std::isinf(lo))
+        r = fmt::format("a finite number {} {}", hi_end == End::Open ? "<" : "≤", readable(hi));
+    else
+        r = fmt::format("a number in {}{}, {}{}", lo_end == End::Open ? "(" : "[", readable(lo), readable(hi),
+                        hi_end == End::Open ? ")" : "]");
+    return unit.empty() ? r : r + " " + unit;
+}
+
+// Strict decimal parse of the whole text.
+bool parse_real(const std::string& text, double& out) {
+    if (text.empty())
+        return false;
+    const char* first = text.data();
+    if (*first == '+')
+        ++first;
+    const auto r = std::from_chars(first, text.data() + text.size(), out);
+    return r.ec == std::errc() && r.ptr == text.data() + text.size();
+}
+
+std::string check_real(const std::string& text, double lo, double hi, End lo_end, End hi_end,
+                       const std::string& unit) {
+    double v = 0.0;
+    const std::string expected = "expected " + range_text(lo, hi, lo_end, hi_end, unit);
+    if (!parse_real(text, v)) {
+        // from_chars reports out-of-range doubles (1e400) as errors too.
+        return fmt::format("'{}' is not a number; {}", text.size() > 40 ? text.substr(0, 40) + "..." : text, expected);
+    }
+    if (!std::isfinite(v))
+        return fmt::format("{} is not a finite number; {}", readable(v), expected);
+    const bool below = lo_end == End::Open ? !(v > lo) : !(v >= lo);
+    const bool above = hi_end == End::Open ? !(v < hi) : !(v <= hi);
+    if (below || above)
+        return fmt::format("{} is out of range; {}", readable(v), expected);
+    return {};
+}
+
+} // namespace
+
+CLI::Validator real_in(double lo, double hi, const std::string& unit, End lo_end, End hi_end) {
+    return CLI::Validator(
+        [=](std::string& text) { return check_real(text, lo, hi, lo_end, hi_end, unit); },
+        "(" + range_text(lo, hi, lo_end, hi_end, unit) + ")", "real_in");
+}
+
+CLI::Validator auto_or_real_in(double lo, double hi, const std::string& unit, End lo_end, End hi_end) {
+    return CLI::Validator(
+        [=](std::string& text) {
+            if (text == "auto")
+                return std::string();
+            const std::string e = check_real(text, lo, hi, lo_end, hi_end, unit);
+            return e.empty() ? e : e + ", or auto";
+        },
+        "(auto, or " + range_text(lo, hi, lo_end, hi_end, unit) + ")", "auto_or_real_in");
+}
+
+CLI::Validator integer_in(std::int64_t lo, std::int64_t hi, const std::string& unit) {
+    const std::string expected =
+        fmt::format("expected a whole number from {} to {}{}", lo, hi, unit.empty() ? "" : " " + unit);
+    return CLI::Validator(
+        [=](std::string& text) -> std::string {
+            std::int64_t v = 0;
+            const char* first = text.data();
+            if (!text.empty() && *first == '+')
+                ++first;
+            const auto r = std::from_chars(first, text.data() + text.size(), v);
+            if (text.empty() || r.ptr != text.data() + text.size() || r.ec == std::errc::invalid_argument)
+                return fmt::format("'{}' is not a whole number; {}",
+                                   text.size() > 40 ? text.substr(0, 40) + "..." : text, expected);
+            if (r.ec == std::errc::result_out_of_range || v < lo || v > hi)
+                return fmt::format("{} is out of range; {}", text.size() > 40 ? text.substr(0, 40) + "..." : text,
+                                   expected);
+            return {};
+        },
+        fmt::format("({} to {}{})", lo, hi, unit.empty() ? "" : " " + unit), "integer_in");
+}
+
+std::string lower_extension(const std::string& path) {
+    std::string e = fs::path(path).extension().string();
+    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return e;
+}
+
+void check_output_path(const std::string& path, std::initializer_list<const char*> extensions, const char* flag) {
+    if (path.empty())
+        throw UsageError("the output path is empty", flag);
+    if (path == "-")
+        return; // stdout, where the command allows it
+    if (extensions.size() > 0) {
+        const std::string ext = lower_extension(path);
+        std::string list;
+        bool known = false;
+        for (const char* e : extensions) {
+            known |= ext == e;
+            list += (list.empty() ? "" : " or ") + std::string(e);
+        }
+        if (!known)
+            throw UsageError(fmt::format("cannot write '{}' files; use {}", ext.empty() ? "(no extension)" : ext, list),
+                             flag);
+    }
+    const fs::path p(path);
+    const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec))
+        throw Error(fmt::format("the output folder {} does not exist", dir.string()), flag);
+    if (::access(dir.c_str(), W_OK | X_OK) != 0)
+        throw Error(fmt::format("cannot write in the output folder {}: {}", dir.string(), std::strerror(errno)), flag);
+    if (fs::is_directory(p, ec))
+        throw Error(fmt::format("the output path {} is a folder", path), flag);
+}
+
+bool given(const CLI::App& sub, const char* flag) {
+    const CLI::Option* o = sub.get_option_no_throw(flag);
+    return o && o->count() > 0;
+}
+
+void refuse_if_given(const CLI::App& sub, const char* flag, const std::string& reason) {
+    if (given(sub, flag))
+        throw UsageError(fmt::format("{} does not apply {}", flag, reason), flag);
+}
+
+} // namespace skybake::cli
