@@ -27,7 +27,8 @@ std::string temp_dir(const std::string& name) {
     return p.string();
 }
 
-CliResult run_cli(const std::vector<std::string>& args, int timeout_s) {
+namespace {
+CliResult run(const std::vector<std::string>& args, int timeout_s, double signal_after_s, int sig) {
     namespace fs = std::filesystem;
     static int counter = 0;
     const fs::path dir = temp_dir("cli-capture");
@@ -52,6 +53,10 @@ CliResult run_cli(const std::vector<std::string>& args, int timeout_s) {
         _exit(127);
     }
     int status = 0;
+    if (signal_after_s > 0.0) {
+        usleep(useconds_t(signal_after_s * 1e6));
+        kill(pid, sig);
+    }
     waitpid(pid, &status, 0);
     if (WIFEXITED(status))
         r.exit_code = WEXITSTATUS(status);
@@ -66,6 +71,13 @@ CliResult run_cli(const std::vector<std::string>& args, int timeout_s) {
     r.out = slurp(out_path);
     r.err = slurp(err_path);
     return r;
+}
+} // namespace
+
+CliResult run_cli(const std::vector<std::string>& args, int timeout_s) { return run(args, timeout_s, 0.0, 0); }
+
+CliResult run_cli_interrupted(const std::vector<std::string>& args, double after_s, int sig, int timeout_s) {
+    return run(args, timeout_s, after_s, sig);
 }
 
 } // namespace skybake::test

@@ -18,6 +18,10 @@ struct CliResult {
 // args do not include the program name. timeout_s kills a hung process.
 CliResult run_cli(const std::vector<std::string>& args, int timeout_s = 120);
 
+// Runs the CLI and sends it `sig` after `after_s` seconds (as a user's Ctrl-C
+// or a job scheduler's SIGTERM would).
+CliResult run_cli_interrupted(const std::vector<std::string>& args, double after_s, int sig, int timeout_s = 120);
+
 // A fresh empty folder under the build tree's temp area, removed by the OS later.
 std::string temp_dir(const std::string& name);
 

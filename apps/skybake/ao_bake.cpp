@@ -192,11 +192,11 @@ void add_ao_bake(CLI::App& group) {
         ->capture_default_str();
     sub->add_option("--max-distance", o->max_distance,
                     "Ignore occluders further than this, in mesh units (default: unlimited)")
-        ->check(real_in(0.0, INFINITY, "mesh units", End::Open));
+        ->check(real_in(0.0, 1e30, "mesh units", End::Open)); // stored as a float
     sub->add_option("--offset", o->offset,
                     "Move ray origins this far along the normal, in mesh units; auto: 1e-4 x the bounding-box "
                     "diagonal")
-        ->check(auto_or_real_in(0.0, INFINITY, "mesh units"))
+        ->check(auto_or_real_in(0.0, 1e30, "mesh units"))
         ->capture_default_str();
     sub->add_option("--back-faces", o->back_faces,
                     "occlude: both sides of a triangle block rays; ignore: rays pass through triangles seen from "

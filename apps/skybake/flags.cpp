@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <fmt/format.h>
@@ -137,8 +138,16 @@ void check_output_path(const std::string& path, std::initializer_list<const char
     std::error_code ec;
     if (!fs::is_directory(dir, ec))
         throw Error(fmt::format("the output folder {} does not exist", dir.string()), flag);
-    if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    // Creating a file is the only test that holds for every user and file
+    // system (root passes access() on read-only mounts such as /proc).
+    const fs::path probe = dir / fmt::format(".skybake-probe-{}", ::getpid());
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+    if (fd < 0 && errno != EEXIST) // a probe left by a killed run proves little either way
         throw Error(fmt::format("cannot write in the output folder {}: {}", dir.string(), std::strerror(errno)), flag);
+    if (fd >= 0) {
+        ::close(fd);
+        ::unlink(probe.c_str());
+    }
     if (fs::is_directory(p, ec))
         throw Error(fmt::format("the output path {} is a folder", path), flag);
 }
