@@ -21,7 +21,7 @@ std::string readable(double x) {
         return "nan";
     if (std::isinf(x))
         return x > 0 ? "inf" : "-inf";
-    if (x == std::floor(x) && std::abs(x) < 1e15)
+    if (x == std::floor(x) && std::abs(x) < 1e9)
         return fmt::format("{:.0f}", x);
     return fmt::format("{:.6g}", x);
 }
