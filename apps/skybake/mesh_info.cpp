@@ -19,7 +19,7 @@ void run(const MeshInfoOptions& o) {
         nlohmann::json attrs = nlohmann::json::array();
         for (const auto& a : mesh.attributes)
             attrs.push_back({{"name", a.name}, {"components", a.components}});
-        print_json({{"file", o.input},
+        print_json({{"input", o.input},
                     {"format", rep.format},
                     {"vertices", mesh.vertex_count()},
                     {"triangles", mesh.triangle_count()},
