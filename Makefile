@@ -53,8 +53,10 @@ demo: build
 bench: build
 	./scripts/bench.sh $(BUILD)
 
+# Every parser's libFuzzer target for FUZZ_SECONDS (default 120) each; new
+# coverage is merged into tools/fuzz/corpus/, which CI replays (fuzz.replay.*).
 fuzz: deps
-	./tools/fuzz/run.sh
+	FUZZ_SECONDS=$${FUZZ_SECONDS:-120} ./tools/fuzz/run.sh
 
 install: build
 	cmake --install $(BUILD) --prefix $(PREFIX)

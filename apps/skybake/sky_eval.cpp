@@ -1,5 +1,4 @@
 // skybake sky eval: the sky function I(cos α0, cos β0, cos θ0, ρ0) over a CSV file.
-#include <charconv>
 #include <chrono>
 #include <iostream>
 #include <sstream>
@@ -13,40 +12,6 @@ namespace skybake::cli {
 
 namespace {
 
-std::string trim(std::string_view s) {
-    std::size_t a = 0, b = s.size();
-    while (a < b && (s[a] == ' ' || s[a] == '\t' || s[a] == '\r'))
-        ++a;
-    while (b > a && (s[b - 1] == ' ' || s[b - 1] == '\t' || s[b - 1] == '\r'))
-        --b;
-    return std::string(s.substr(a, b - a));
-}
-
-bool parse_number(const std::string& s, double& out) {
-    if (s.empty())
-        return false;
-    const char* first = s.data();
-    if (*first == '+')
-        ++first;
-    const auto r = std::from_chars(first, s.data() + s.size(), out);
-    return r.ec == std::errc() && r.ptr == s.data() + s.size();
-}
-
-std::vector<std::string> split_fields(const std::string& line) {
-    std::vector<std::string> fields;
-    std::size_t start = 0;
-    for (;;) {
-        const std::size_t comma = line.find(',', start);
-        fields.push_back(trim(std::string_view(line).substr(start, comma - start)));
-        if (comma == std::string::npos)
-            break;
-        start = comma + 1;
-    }
-    return fields;
-}
-
-constexpr const char* kColumns[4] = {"cos_view_zenith", "cos_view_sun", "cos_sun_zenith", "density"};
-
 // The CSV text of a file, or of standard input for "-".
 std::string read_input(const std::string& path) {
     if (path != "-")
@@ -56,64 +21,9 @@ std::string read_input(const std::string& path) {
     return s.str();
 }
 
-// Rows of the four columns of kColumns. The first line is a header naming
-// them, in any order (other names are an error), or the first row of numbers,
-// read in kColumns' order. Blank lines are skipped; no rows is an error.
+// Rows of a sky CSV file, or of standard input for "-" (see read_sky_samples_csv).
 std::vector<SkySample> read_samples(const std::string& path) {
-    const std::string name = path == "-" ? std::string("standard input") : path;
-    const std::string text = read_input(path);
-    std::vector<SkySample> out;
-    std::istringstream in(text);
-    std::string line;
-    int number = 0;
-    bool first_content = true;
-    int column[4] = {0, 1, 2, 3}; // field index of each of kColumns
-    while (std::getline(in, line)) {
-        ++number;
-        const std::string where = fmt::format("line {} of {}", number, name);
-        if (trim(line).empty())
-            continue;
-        const std::vector<std::string> fields = split_fields(line);
-        double dummy;
-        if (first_content && !parse_number(fields[0], dummy)) { // a header: columns by name
-            first_content = false;
-            for (int& c : column)
-                c = -1;
-            for (std::size_t i = 0; i < fields.size(); ++i) {
-                int k = 0;
-                while (k < 4 && fields[i] != kColumns[k])
-                    ++k;
-                if (k == 4)
-                    throw Error(fmt::format("unknown column '{}'; the columns are cos_view_zenith, cos_view_sun, "
-                                            "cos_sun_zenith and density, in any order",
-                                            fields[i]),
-                                where);
-                if (column[k] >= 0)
-                    throw Error(fmt::format("column '{}' appears twice", fields[i]), where);
-                column[k] = int(i);
-            }
-            for (int k = 0; k < 4; ++k)
-                if (column[k] < 0)
-                    throw Error(fmt::format("the header has no column '{}'", kColumns[k]), where);
-            continue;
-        }
-        first_content = false;
-        if (fields.size() != 4)
-            throw Error(fmt::format("expected 4 comma-separated numbers, got {} fields", fields.size()), where);
-        double v[4];
-        for (int k = 0; k < 4; ++k)
-            if (!parse_number(fields[std::size_t(column[k])], v[k]))
-                throw Error(fmt::format("{} '{}' is not a number", kColumns[k], fields[std::size_t(column[k])]),
-                            where);
-        const SkySample s{float(v[0]), float(v[1]), float(v[2]), float(v[3])};
-        check_sky_sample(s, where);
-        if (!(v[3] > 0.0 && v[3] <= 1.0))
-            throw Error(fmt::format("density {} is outside (0, 1]", v[3]), where);
-        out.push_back(s);
-    }
-    if (out.empty())
-        throw Error("no samples: the file has no rows of numbers", name);
-    return out;
+    return read_sky_samples_csv(read_input(path), path == "-" ? std::string("standard input") : path);
 }
 
 } // namespace

@@ -153,6 +153,13 @@ bool is_valid_cosine_triple(double a, double b, double c, double tolerance = 1e-
 bool is_valid_sky_sample(const SkySample& sample, double tolerance = 1e-6);
 // Throws skybake::Error saying what is wrong, naming `where`.
 void check_sky_sample(const SkySample& sample, const std::string& where);
+// Samples from CSV text with the columns cos_view_zenith, cos_view_sun,
+// cos_sun_zenith and density. The first line is either a header naming all
+// four, in any order (other or repeated names are an error), or the first row
+// of numbers, read in that order. Blank lines are skipped. Throws
+// skybake::Error naming the line of `name` (a file name, for messages) for a
+// row that is not four numbers or not a valid sample, and for no rows at all.
+std::vector<SkySample> read_sky_samples_csv(std::string_view text, const std::string& name);
 // `count` valid samples drawn uniformly from [−1,1]³ × (0,1] with rejection of
 // invalid triples; deterministic in seed, independent of the thread count.
 std::vector<SkySample> draw_sky_samples(std::size_t count, std::uint64_t seed);

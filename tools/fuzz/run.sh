@@ -1,33 +1,69 @@
 #!/usr/bin/env bash
-# Builds the mesh-loader fuzzer with clang and runs it.
-#   tools/fuzz/run.sh [SECONDS]      (default 60)
-# The seed corpus is built from Assimp's test models and skybake's own output;
-# new inputs go to tools/fuzz/corpus-run/, crashes to tools/fuzz/crash-*.
+# Fuzzes every parser with libFuzzer (clang, ASan + UBSan), then merges what
+# found new coverage into the corpus kept in the repository.
+#   tools/fuzz/run.sh [TARGET...]          (default: every target)
+#   FUZZ_SECONDS=120 make fuzz             (seconds per target; default 120)
+#   FUZZ_JOBS=2                            (targets fuzzed at once; default: cores)
+# Per target: tools/fuzz/corpus/NAME is the kept corpus (seeds, every past
+# crash, merged coverage), corpus-run/NAME the working set, crashes land in
+# crashes/NAME/. The last lines are a table: executions, coverage, crashes.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
-secs=${1:-60}
+secs=${FUZZ_SECONDS:-120}
+jobs=${FUZZ_JOBS:-$(nproc)}
 build=$root/build-fuzz
-CC=clang CXX=clang++ cmake -S "$here" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
-cmake --build "$build" --target fuzz_mesh_loader -j "$(nproc)"
+source_targets() { sed -n 's/^set(SKYBAKE_FUZZ_TARGETS \(.*\))$/\1/p' "$here/targets.cmake"; }
+targets=("$@")
+[ ${#targets[@]} -gt 0 ] || read -r -a targets <<<"$(source_targets)"
 
-corpus=$here/corpus-run
-mkdir -p "$corpus"
-models=/usr/share/assimp/models
-# Seeds: the first byte selects the reader (see fuzz_mesh_loader.cpp).
-seed() { # index file
-  [ -f "$2" ] || return 0
-  local size; size=$(stat -c %s "$2")
-  [ "$size" -le 65536 ] || return 0
-  { printf "\\x$(printf %02x "$1")"; cat "$2"; } > "$corpus/seed-$1-$(basename "$2")"
+CC=clang CXX=clang++ cmake -S "$here" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build "$build" -j "$(nproc)" --target $(printf 'fuzz_%s ' "${targets[@]}")
+
+# Assimp's test models seed the mesh loader (the first byte picks the reader).
+seed_mesh_loader() {
+  local dir=$1 models=/usr/share/assimp/models i f size
+  local -a globs=("PLY/*.ply" "glTF2/*/*.glb" "glTF2/*/*.gltf" "OBJ/*.obj" "OFF/*.off" "STL/*.stl")
+  for i in "${!globs[@]}"; do
+    for f in $models/${globs[$i]}; do
+      [ -f "$f" ] || continue
+      size=$(stat -c %s "$f"); [ "$size" -le 65536 ] || continue
+      { printf "\\x$(printf %02x "$i")"; cat "$f"; } > "$dir/seed-$i-$(basename "$f")"
+    done
+  done
 }
-for f in "$models"/PLY/*.ply; do seed 0 "$f"; done
-for f in "$models"/glTF2/*/*.glb; do seed 1 "$f"; done
-for f in "$models"/glTF2/*/*.gltf; do seed 2 "$f"; done
-for f in "$models"/OBJ/*.obj; do seed 3 "$f"; done
-for f in "$models"/OFF/*.off; do seed 4 "$f"; done
-for f in "$models"/STL/*.stl; do seed 5 "$f"; done
-cd "$here"
-ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 LSAN_OPTIONS=suppressions=$here/lsan.supp \
-  "$build/fuzz_mesh_loader" -max_total_time="$secs" -max_len=65536 -rss_limit_mb=4096 -timeout=20 \
-  -print_final_stats=1 "$corpus"
+
+run_one() {
+  local t=$1 work=$here/corpus-run/$t crashes=$here/crashes/$t log=$here/crashes/$t.log dict=()
+  mkdir -p "$work" "$crashes"
+  cp -n "$here/corpus/$t"/* "$work"/ 2>/dev/null || true
+  [ "$t" = mesh_loader ] && seed_mesh_loader "$work"
+  [ -f "$here/$t.dict" ] && dict=(-dict="$here/$t.dict")
+  ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 LSAN_OPTIONS=suppressions=$here/lsan.supp \
+    "$build/fuzz_$t" "${dict[@]}" -max_total_time="$secs" -max_len=65536 -rss_limit_mb=4096 -timeout=20 \
+    -print_final_stats=1 -artifact_prefix="$crashes/" "$work" >"$log" 2>&1 || true
+  # Keep what adds coverage (and every crash) in the repository's corpus.
+  "$build/fuzz_$t" -merge=1 "$here/corpus/$t" "$work" >>"$log" 2>&1 || true
+  for c in "$crashes"/crash-* "$crashes"/leak-* "$crashes"/timeout-* "$crashes"/oom-*; do
+    [ -f "$c" ] && cp -n "$c" "$here/corpus/$t/"
+  done
+  return 0
+}
+
+pids=()
+for t in "${targets[@]}"; do
+  run_one "$t" &
+  pids+=($!)
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do sleep 1; done
+done
+wait "${pids[@]}"
+
+printf '\n%-12s %12s %8s %8s %8s\n' target executions cov ft crashes
+for t in "${targets[@]}"; do
+  log=$here/crashes/$t.log
+  execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
+  cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | cut -d' ' -f2)
+  ft=$(grep -o 'ft: [0-9]*' "$log" | tail -1 | cut -d' ' -f2)
+  crashes=$(find "$here/crashes/$t" -type f | wc -l)
+  printf '%-12s %12s %8s %8s %8s\n' "$t" "${execs:-?}" "${cov:-?}" "${ft:-?}" "$crashes"
+done
