@@ -12,6 +12,8 @@
 
 #include <fmt/format.h>
 
+#include "core/parse_number.h"
+
 namespace skybake::cli {
 
 namespace fs = std::filesystem;
@@ -42,22 +44,12 @@ std::string range_text(double lo, double hi, End lo_end, End hi_end, const std::
     return unit.empty() ? r : r + " " + unit;
 }
 
-// Strict decimal parse of the whole text.
-bool parse_real(const std::string& text, double& out) {
-    if (text.empty())
-        return false;
-    const char* first = text.data();
-    if (*first == '+')
-        ++first;
-    const auto r = std::from_chars(first, text.data() + text.size(), out);
-    return r.ec == std::errc() && r.ptr == text.data() + text.size();
-}
 
 std::string check_real(const std::string& text, double lo, double hi, End lo_end, End hi_end,
                        const std::string& unit) {
     double v = 0.0;
     const std::string expected = "expected " + range_text(lo, hi, lo_end, hi_end, unit);
-    if (!parse_real(text, v)) {
+    if (!parse_decimal(text, v)) {
         // from_chars reports out-of-range doubles (1e400) as errors too.
         return fmt::format("'{}' is not a number; {}", text.size() > 40 ? text.substr(0, 40) + "..." : text, expected);
     }

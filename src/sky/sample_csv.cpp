@@ -1,10 +1,10 @@
 // Sky samples from CSV text: the format `skybake sky eval` reads.
-#include <charconv>
 #include <sstream>
 #include <string_view>
 
 #include <fmt/format.h>
 
+#include "core/parse_number.h"
 #include "skybake/error.h"
 #include "skybake/sky.h"
 
@@ -21,15 +21,6 @@ std::string trim(std::string_view s) {
     return std::string(s.substr(a, b - a));
 }
 
-bool parse_number(const std::string& s, double& out) {
-    if (s.empty())
-        return false;
-    const char* first = s.data();
-    if (*first == '+')
-        ++first;
-    const auto r = std::from_chars(first, s.data() + s.size(), out);
-    return r.ec == std::errc() && r.ptr == s.data() + s.size();
-}
 
 std::vector<std::string> split_fields(const std::string& line) {
     std::vector<std::string> fields;
@@ -63,7 +54,7 @@ std::vector<SkySample> read_sky_samples_csv(std::string_view text, const std::st
             continue;
         const std::vector<std::string> fields = split_fields(line);
         double dummy;
-        if (first_content && !parse_number(fields[0], dummy)) { // a header: columns by name
+        if (first_content && !parse_decimal(fields[0], dummy)) { // a header: columns by name
             first_content = false;
             for (int& c : column)
                 c = -1;
@@ -90,7 +81,7 @@ std::vector<SkySample> read_sky_samples_csv(std::string_view text, const std::st
             throw Error(fmt::format("expected 4 comma-separated numbers, got {} fields", fields.size()), where);
         double v[4];
         for (int k = 0; k < 4; ++k)
-            if (!parse_number(fields[std::size_t(column[k])], v[k]))
+            if (!parse_decimal(fields[std::size_t(column[k])], v[k]))
                 throw Error(fmt::format("{} '{}' is not a number", kColumns[k], fields[std::size_t(column[k])]),
                             where);
         const SkySample s{float(v[0]), float(v[1]), float(v[2]), float(v[3])};
