@@ -271,7 +271,7 @@ Atmosphere atmosphere_from_json(std::string_view text, const std::string& where)
     json j;
     try {
         j = json::parse(text.begin(), text.end());
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) { // parse_error, and out_of_range for a number such as 1e3080
         throw Error(fmt::format("not valid JSON: {}", e.what()), where);
     }
     if (!j.is_object())

@@ -83,3 +83,17 @@ TEST(AtmosphereValidate, JsonFieldsAreCheckedToo) {
         EXPECT_NE(std::string(e.what()).find("phase g must be in (-1, 1)"), std::string::npos) << e.what();
     }
 }
+
+TEST(AtmosphereValidate, ANumberBeyondDoubleIsAnErrorNotACrash) {
+    // Found by the fuzzer: nlohmann::json throws out_of_range, not parse_error,
+    // for 1e30885; it escaped as an unknown exception.
+    std::string text = atmosphere_to_json(atmosphere_preset("earth"));
+    text.replace(text.find("0.005802"), 8, "0.0021e30885");
+    try {
+        atmosphere_from_json(text, "big.json");
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("not valid JSON"), std::string::npos) << e.what();
+        EXPECT_EQ(e.where(), "big.json");
+    }
+}
