@@ -61,7 +61,7 @@ TEST(GpuSkyCli, UnknownDeviceIsAnError) {
     const std::string dir = temp_dir("gpu-cli-bad");
     const auto r = run_cli({"sky", "eval", "--preset", "earth", "--input", write_input(dir), "--output",
                             dir + "/out.csv", "--device", "tpu"});
-    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.exit_code, 2); // a bad flag value: a usage error
     EXPECT_EQ(r.err_lines(), 1) << r.err;
 }
 
