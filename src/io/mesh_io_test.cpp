@@ -323,6 +323,17 @@ TEST(HostileInput, PlyNanCoordinate) {
     EXPECT_THROW(load_text(kPlyHead + "0 0 0\n1e999 0 0\n0 1 0\n3 0 1 2\n", "ply"), Error);
 }
 
+TEST(HostileInput, PlyElementWithoutPropertiesAndAHugeCount) {
+    // Found by the fuzzer: an element of 4e17 items with no properties was
+    // "read past" one item at a time, for ever. It takes no bytes: the file loads.
+    const std::string head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                             "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+                             "element junk 409927646082434475\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    const auto t0 = std::chrono::steady_clock::now();
+    EXPECT_EQ(load_text(head, "ply").triangle_count(), 1u);
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
+}
+
 TEST(HostileInput, PlyIndexOutOfRange) {
     EXPECT_THROW(load_text(kPlyHead + "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n", "ply"), Error);
     EXPECT_THROW(load_text(kPlyHead + "0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n", "ply"), Error);

@@ -381,7 +381,11 @@ RawImport read_ply(const void* data, std::size_t size, const std::string& where,
                 }
             }
         } else {
-            // Other elements (edges, materials, ...): read past them.
+            // Other elements (edges, materials, ...): read past them. One with
+            // no properties takes no bytes, whatever its count (a count of
+            // 4e17 looped for ever: found by the fuzzer).
+            if (e.properties.empty())
+                continue;
             for (std::uint64_t k = 0; k < e.count; ++k)
                 for (const Property& p : e.properties) {
                     if (p.is_list) {
