@@ -76,8 +76,7 @@ void expect_refused(const CliResult& r, int code, const std::string& needle, con
     EXPECT_EQ(r.exit_code, code) << what << "\n" << r.err;
     EXPECT_EQ(r.err_lines(), 1) << what << "\n" << r.err;
     EXPECT_EQ(r.err.rfind("skybake: error: ", 0), 0u) << what << "\n" << r.err;
-    EXPECT_NE(r.err.find(needle), std::string::npos) << what << ": the message should name " << needle << "\n"
-                                                       << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << what << ": the message should name " << needle << "\n" << r.err;
 }
 
 // Files in a folder (the outputs a failed command must not leave, temporary ones included).
@@ -91,7 +90,7 @@ std::vector<std::string> files_in(const std::string& dir) {
 struct NumericFlag {
     std::vector<std::string> command; // a valid command without the flag; {out} is an empty folder
     const char* flag;
-    bool negative_ok, zero_ok;         // whether -1 and 0 are legal values
+    bool negative_ok, zero_ok; // whether -1 and 0 are legal values
 };
 
 // Every numeric flag of every sub-command.
@@ -112,23 +111,38 @@ const NumericFlag kNumericFlags[] = {
     {{"sky", "eval", "--input", "{csv}", "--output", "{out}/o.csv"}, "--steps", false, false},
     {{"sky", "eval", "--input", "{csv}", "--output", "{out}/o.csv"}, "--shells", false, false},
     {{"sky", "eval", "--input", "{csv}", "--output", "{out}/o.csv"}, "--cosines", false, false},
-    {{"sky", "render", "--sun-elevation-deg", "10", "--size", "8x8", "-o", "{out}/r.png"}, "--altitude-km", false, true},
+    {{"sky", "render", "--sun-elevation-deg", "10", "--size", "8x8", "-o", "{out}/r.png"},
+     "--altitude-km",
+     false,
+     true},
     {{"sky", "render", "--altitude-km", "0", "--size", "8x8", "-o", "{out}/r.png"}, "--sun-elevation-deg", true, true},
     {{"sky", "render", "--altitude-km", "0", "--sun-elevation-deg", "10", "--size", "8x8", "-o", "{out}/r.png"},
-     "--sun-azimuth-deg", true, true},
+     "--sun-azimuth-deg",
+     true,
+     true},
     {{"sky", "render", "--altitude-km", "0", "--sun-elevation-deg", "10", "--view", "camera", "--size", "8x8", "-o",
       "{out}/r.png"},
-     "--fov", false, false},
+     "--fov",
+     false,
+     false},
     {{"sky", "render", "--altitude-km", "0", "--sun-elevation-deg", "10", "--view", "camera", "--size", "8x8", "-o",
       "{out}/r.png"},
-     "--yaw", true, true},
+     "--yaw",
+     true,
+     true},
     {{"sky", "render", "--altitude-km", "0", "--sun-elevation-deg", "10", "--view", "camera", "--size", "8x8", "-o",
       "{out}/r.png"},
-     "--pitch", true, true},
+     "--pitch",
+     true,
+     true},
     {{"sky", "render", "--altitude-km", "0", "--sun-elevation-deg", "10", "--size", "8x8", "-o", "{out}/r.png"},
-     "--steps", false, false},
+     "--steps",
+     false,
+     false},
     {{"sky", "render", "--altitude-km", "0", "--sun-elevation-deg", "10", "--size", "8x8", "-o", "{out}/r.png"},
-     "--exposure", true, true},
+     "--exposure",
+     true,
+     true},
     {{"sky", "train", "-o", "{out}/w.json"}, "--samples", false, false},
     {{"sky", "train", "-o", "{out}/w.json"}, "--log-range", false, false},
     {{"sky", "train", "-o", "{out}/w.json"}, "--epochs", false, true},
@@ -194,9 +208,11 @@ const OutputFlag kOutputFlags[] = {
     {{"sky", "eval", "--input", "{csv}"}, "--output", "o.csv"},
     {{"sky", "render", "--altitude-km", "0", "--sun-elevation-deg", "10", "--size", "8x8"}, "-o", "r.png"},
     {{"sky", "train", "--samples", "100", "--epochs", "1", "--lm-iterations", "0"}, "-o", "w.json"},
-    {{"sky", "train", "--samples", "100", "--epochs", "1", "--lm-iterations", "0", "-o", "{out}/w.json"}, "--curve",
+    {{"sky", "train", "--samples", "100", "--epochs", "1", "--lm-iterations", "0", "-o", "{out}/w.json"},
+     "--curve",
      "c.csv"},
-    {{"sky", "train", "--samples", "100", "--epochs", "1", "--lm-iterations", "0", "-o", "{out}/w.json"}, "--chart",
+    {{"sky", "train", "--samples", "100", "--epochs", "1", "--lm-iterations", "0", "-o", "{out}/w.json"},
+     "--chart",
      "c.png"},
     {{"sky", "export", "{model}", "--format", "glsl"}, "-o", "s.glsl"},
     {{"sky", "preset", "earth"}, "-o", "e.json"},
@@ -236,8 +252,7 @@ TEST(CliContract, AFailedCommandLeavesExistingOutputsUnchanged) {
     std::ofstream(target) << "the user's file";
     for (const std::vector<std::string>& bad :
          {std::vector<std::string>{"--preview", "/nonexistent-skybake-folder/p.png"},
-          std::vector<std::string>{"--bits", "/proc/b.bin"},
-          std::vector<std::string>{"--preview", out + "/p.jpg"},
+          std::vector<std::string>{"--bits", "/proc/b.bin"}, std::vector<std::string>{"--preview", out + "/p.jpg"},
           std::vector<std::string>{"--preview-azimuth", "nan", "--preview", out + "/p.png"}}) {
         std::vector<std::string> args = {"ao", inputs().mesh, "-o", target, "--rule", "lebedev:6"};
         args.insert(args.end(), bad.begin(), bad.end());
@@ -258,19 +273,19 @@ TEST(CliContract, MessagesNameTheValueAndTheRangeReadably) {
     expect_refused(a, 2, "-5 is out of range; expected a whole number from 20 to 50000000", "negative count");
     const CliResult b = run_cli({"ao", inputs().mesh, "-o", out + "/a.glb", "--max-distance", "1e30"});
     EXPECT_EQ(b.exit_code, 0) << b.err; // the largest distance allowed (it is stored as a float)
-    const CliResult c = run_cli({"sky", "render", "--altitude-km", "0", "--sun-elevation-deg", "1000", "-o",
-                                 out + "/r.png"});
+    const CliResult c =
+        run_cli({"sky", "render", "--altitude-km", "0", "--sun-elevation-deg", "1000", "-o", out + "/r.png"});
     expect_refused(c, 2, "1000 is out of range; expected a number in [-90, 90] degrees", "elevation");
     EXPECT_LT(c.err.size(), 200u) << "no 300-digit numbers";
     const CliResult d = run_cli({"foo"});
     expect_refused(d, 2, "unknown command 'foo'", "unknown command");
     const CliResult e = run_cli({"sky", "frobnicate"});
     expect_refused(e, 2, "unknown command 'frobnicate' for 'skybake sky'", "unknown sub-command");
-    const CliResult f = run_cli({"sky", "train", "--samples", "1000", "--epochs", "1", "--lm-iterations", "0", "-q",
-                                 "-o", out + "/w.json"});
+    const CliResult f = run_cli(
+        {"sky", "train", "--samples", "1000", "--epochs", "1", "--lm-iterations", "0", "-q", "-o", out + "/w.json"});
     EXPECT_EQ(f.exit_code, 0) << "the default mini-batch shrinks to --samples: " << f.err;
-    const CliResult g = run_cli({"sky", "render", "--altitude-km", "0", "--sun-elevation-deg", "10", "--fov", "40",
-                                 "-o", out + "/r.png"});
+    const CliResult g = run_cli(
+        {"sky", "render", "--altitude-km", "0", "--sun-elevation-deg", "10", "--fov", "40", "-o", out + "/r.png"});
     expect_refused(g, 2, "--fov does not apply to --view fisheye", "a flag of another mode");
     const CliResult h = run_cli({"sky", "optical-length", "--paper-r", "5", "--density", "1", "--cos-zenith", "1"});
     expect_refused(h, 2, "--paper-r does not apply to preset earth", "a flag of another preset");
@@ -298,7 +313,8 @@ TEST(CliContract, OpticalLengthMethodsAgreeOnHittingTheGround) {
 TEST(CliContract, SignalsStopABakeAndAnImportCleanly) {
     const std::string dir = skybake::test::temp_dir("contract-signals");
     // A bake of a few seconds: 2CylinderEngine at 5810 directions.
-    const std::string engine = std::string(SKYBAKE_ASSIMP_MODELS) + "/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
+    const std::string engine =
+        std::string(SKYBAKE_ASSIMP_MODELS) + "/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
     // An import of a few seconds through the isolated Assimp reader: a large OBJ.
     const std::string obj = dir + "/big.obj";
     {

@@ -7,10 +7,10 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
-#include <fcntl.h>
-#include <unistd.h>
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <unistd.h>
 
 #include "core/parse_number.h"
 
@@ -44,9 +44,7 @@ std::string range_text(double lo, double hi, End lo_end, End hi_end, const std::
     return unit.empty() ? r : r + " " + unit;
 }
 
-
-std::string check_real(const std::string& text, double lo, double hi, End lo_end, End hi_end,
-                       const std::string& unit) {
+std::string check_real(const std::string& text, double lo, double hi, End lo_end, End hi_end, const std::string& unit) {
     double v = 0.0;
     const std::string expected = "expected " + range_text(lo, hi, lo_end, hi_end, unit);
     if (!parse_decimal(text, v)) {
@@ -65,9 +63,8 @@ std::string check_real(const std::string& text, double lo, double hi, End lo_end
 } // namespace
 
 CLI::Validator real_in(double lo, double hi, const std::string& unit, End lo_end, End hi_end) {
-    return CLI::Validator(
-        [=](std::string& text) { return check_real(text, lo, hi, lo_end, hi_end, unit); },
-        "(" + range_text(lo, hi, lo_end, hi_end, unit) + ")", "real_in");
+    return CLI::Validator([=](std::string& text) { return check_real(text, lo, hi, lo_end, hi_end, unit); },
+                          "(" + range_text(lo, hi, lo_end, hi_end, unit) + ")", "real_in");
 }
 
 CLI::Validator auto_or_real_in(double lo, double hi, const std::string& unit, End lo_end, End hi_end) {

@@ -1,11 +1,11 @@
 // All-or-nothing output files (skybake/files.h): a writer that fails half way
 // leaves the old target as it was and no temporary file beside it.
-#include <gtest/gtest.h>
-
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+
+#include <gtest/gtest.h>
 #include <unistd.h>
 
 #include "skybake/error.h"

@@ -20,12 +20,12 @@ inline bool gpu_required() {
 
 } // namespace skybake::test
 
-#define SKYBAKE_SKIP_WITHOUT_GPU()                                                                                   \
-    do {                                                                                                             \
-        if (::skybake::cuda_device_count() == 0) {                                                                   \
-            if (::skybake::test::gpu_required())                                                                     \
-                FAIL() << "SKYBAKE_REQUIRE_GPU is set, but no CUDA device is usable: "                                \
-                       << ::skybake::cuda_device_problem();                                                          \
-            GTEST_SKIP() << "no CUDA device: " << ::skybake::cuda_device_problem();                                  \
-        }                                                                                                            \
+#define SKYBAKE_SKIP_WITHOUT_GPU()                                                                                     \
+    do {                                                                                                               \
+        if (::skybake::cuda_device_count() == 0) {                                                                     \
+            if (::skybake::test::gpu_required())                                                                       \
+                FAIL() << "SKYBAKE_REQUIRE_GPU is set, but no CUDA device is usable: "                                 \
+                       << ::skybake::cuda_device_problem();                                                            \
+            GTEST_SKIP() << "no CUDA device: " << ::skybake::cuda_device_problem();                                    \
+        }                                                                                                              \
     } while (0)

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <csignal>
 #include <cstring>
+
 #include <unistd.h>
 
 namespace skybake {
@@ -19,7 +20,10 @@ extern "C" void on_signal(int sig) {
 } // namespace
 
 Interrupted::Interrupted(int signal)
-    : Error(std::string("interrupted by ") + (signal == SIGINT ? "SIGINT" : signal == SIGTERM ? "SIGTERM" : "a signal") +
+    : Error(std::string("interrupted by ") +
+            (signal == SIGINT    ? "SIGINT"
+             : signal == SIGTERM ? "SIGTERM"
+                                 : "a signal") +
             "; no output was written"),
       signal_(signal) {}
 
@@ -33,7 +37,9 @@ void install_interrupt_handlers() {
     sigaction(SIGTERM, &sa, nullptr);
 }
 
-int interrupt_signal() { return g_signal.load(std::memory_order_relaxed); }
+int interrupt_signal() {
+    return g_signal.load(std::memory_order_relaxed);
+}
 
 void check_interrupted() {
     if (const int s = g_signal.load(std::memory_order_relaxed))

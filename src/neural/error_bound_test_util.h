@@ -87,7 +87,7 @@ inline std::array<double, 4> encoded_error_bound(const NeuralSky& net) {
 // night threshold (0.05) may decode as night on one side only and are left
 // out; at least a tenth of the samples must be lit.
 struct BoundCheck {
-    std::size_t lit = 0, outside = 0;   // compared samples, and those outside their bound
+    std::size_t lit = 0, outside = 0; // compared samples, and those outside their bound
     double worst_error = 0.0, worst_fraction = 0.0;
 };
 

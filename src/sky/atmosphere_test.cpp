@@ -16,8 +16,8 @@ namespace {
 struct Case {
     const char* what;
     std::function<void(Atmosphere&)> spoil;
-    const char* message;   // a part of the message
-    const char* where;     // a part of where()
+    const char* message; // a part of the message
+    const char* where;   // a part of where()
 };
 
 const double kNan = std::numeric_limits<double>::quiet_NaN();
@@ -27,16 +27,18 @@ const double kInf = std::numeric_limits<double>::infinity();
 
 TEST(AtmosphereValidate, EachFieldHasItsOwnMessage) {
     const Case cases[] = {
-        {"radius 0", [](Atmosphere& a) { a.planet_radius_km = 0; }, "planet_radius_km must be a positive", "atmosphere 'earth'"},
+        {"radius 0", [](Atmosphere& a) { a.planet_radius_km = 0; }, "planet_radius_km must be a positive",
+         "atmosphere 'earth'"},
         {"radius NaN", [](Atmosphere& a) { a.planet_radius_km = kNan; }, "planet_radius_km", "atmosphere 'earth'"},
-        {"top below", [](Atmosphere& a) { a.top_radius_km = a.planet_radius_km; }, "top_radius_km must be larger", "earth"},
+        {"top below", [](Atmosphere& a) { a.top_radius_km = a.planet_radius_km; }, "top_radius_km must be larger",
+         "earth"},
         {"top inf", [](Atmosphere& a) { a.top_radius_km = kInf; }, "top_radius_km", "earth"},
         {"no components", [](Atmosphere& a) { a.components.clear(); }, "needs 1 to 4 components, got 0", "earth"},
         {"five components", [](Atmosphere& a) { a.components.resize(5, a.components[0]); }, "got 5", "earth"},
         {"first not exponential", [](Atmosphere& a) { a.components[0].profile = DensityProfile::Tent; },
          "first component must have an exponential profile", "earth"},
-        {"scale height", [](Atmosphere& a) { a.components[1].scale_height_km = -1; }, "scale_height_km must be positive",
-         "component 1 ('mie')"},
+        {"scale height", [](Atmosphere& a) { a.components[1].scale_height_km = -1; },
+         "scale_height_km must be positive", "component 1 ('mie')"},
         {"tent width", [](Atmosphere& a) { a.components[2].tent_half_width_km = 0; }, "positive half_width_km",
          "component 2 ('ozone')"},
         {"tent centre", [](Atmosphere& a) { a.components[2].tent_center_km = kNan; }, "finite center_km",
@@ -49,11 +51,14 @@ TEST(AtmosphereValidate, EachFieldHasItsOwnMessage) {
          "extinction_per_km must be at least scattering_per_km", "component 1 ('mie')"},
         {"scatters without phase", [](Atmosphere& a) { a.components[1].phase = PhaseFunction::None; },
          "needs a phase function", "component 1 ('mie')"},
-        {"g = 1", [](Atmosphere& a) { a.components[1].phase_g = 1.0; }, "phase g must be in (-1, 1)", "component 1 ('mie')"},
+        {"g = 1", [](Atmosphere& a) { a.components[1].phase_g = 1.0; }, "phase g must be in (-1, 1)",
+         "component 1 ('mie')"},
         {"g NaN", [](Atmosphere& a) { a.components[1].phase_g = kNan; }, "phase g", "component 1 ('mie')"},
         {"negative sun", [](Atmosphere& a) { a.sun_irradiance.x = -1; }, "sun irradiance must be finite", "earth"},
-        {"sun radius", [](Atmosphere& a) { a.sun_angular_radius_rad = 0.5; }, "angular_radius_rad must be in (0, 0.5)", "earth"},
-        {"sun elevation", [](Atmosphere& a) { a.sun_elevation_deg = kInf; }, "elevation and azimuth must be finite", "earth"},
+        {"sun radius", [](Atmosphere& a) { a.sun_angular_radius_rad = 0.5; }, "angular_radius_rad must be in (0, 0.5)",
+         "earth"},
+        {"sun elevation", [](Atmosphere& a) { a.sun_elevation_deg = kInf; }, "elevation and azimuth must be finite",
+         "earth"},
         {"albedo", [](Atmosphere& a) { a.ground_albedo.z = 1.5; }, "ground_albedo must be in [0, 1]", "earth"},
         {"albedo NaN", [](Atmosphere& a) { a.ground_albedo.x = kNan; }, "ground_albedo", "earth"},
     };

@@ -54,9 +54,8 @@ TEST(SkyRender, FisheyeCentreIsTheZenithRadiance) {
     s.sun_disc = false;
     const Image im = render_sky(earth(), s);
     const double mu_s = std::sin(35.0 * M_PI / 180.0);
-    const glm::dvec3 expect =
-        earth().radiance(SkySample{1.0f, float(mu_s), float(mu_s), 1.0f}, SkyMethod::Tables) *
-        earth().atmosphere().sun_irradiance;
+    const glm::dvec3 expect = earth().radiance(SkySample{1.0f, float(mu_s), float(mu_s), 1.0f}, SkyMethod::Tables) *
+                              earth().atmosphere().sun_irradiance;
     ASSERT_GT(expect.z, 0.0);
     const float* c = im.pixel(32, 32);
     for (int k = 0; k < 3; ++k)

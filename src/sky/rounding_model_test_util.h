@@ -49,7 +49,7 @@ inline std::vector<double> rounding_sensitivity(const SkyModel& model, const std
         for (int field = 0; field < 4; ++field)
             for (int step : {-16, -4, -1, 1, 4, 16}) {
                 SkySample s = samples[i];
-                float* f = field == 0 ? &s.cos_view_zenith
+                float* f = field == 0   ? &s.cos_view_zenith
                            : field == 1 ? &s.cos_view_sun
                            : field == 2 ? &s.cos_sun_zenith
                                         : &s.density;

@@ -21,7 +21,6 @@ std::string trim(std::string_view s) {
     return std::string(s.substr(a, b - a));
 }
 
-
 std::vector<std::string> split_fields(const std::string& line) {
     std::vector<std::string> fields;
     std::size_t start = 0;
@@ -36,7 +35,6 @@ std::vector<std::string> split_fields(const std::string& line) {
 }
 
 constexpr const char* kColumns[4] = {"cos_view_zenith", "cos_view_sun", "cos_sun_zenith", "density"};
-
 
 } // namespace
 
@@ -82,8 +80,7 @@ std::vector<SkySample> read_sky_samples_csv(std::string_view text, const std::st
         double v[4];
         for (int k = 0; k < 4; ++k)
             if (!parse_decimal(fields[std::size_t(column[k])], v[k]))
-                throw Error(fmt::format("{} '{}' is not a number", kColumns[k], fields[std::size_t(column[k])]),
-                            where);
+                throw Error(fmt::format("{} '{}' is not a number", kColumns[k], fields[std::size_t(column[k])]), where);
         const SkySample s{float(v[0]), float(v[1]), float(v[2]), float(v[3])};
         check_sky_sample(s, where);
         if (!(v[3] > 0.0 && v[3] <= 1.0))

@@ -40,7 +40,9 @@ double to_sphere(const glm::dvec3& p, const glm::dvec3& d, double r) {
     return -b + std::sqrt(b * b - c);
 }
 
-glm::dvec3 exp3(const glm::dvec3& x) { return {std::exp(x.x), std::exp(x.y), std::exp(x.z)}; }
+glm::dvec3 exp3(const glm::dvec3& x) {
+    return {std::exp(x.x), std::exp(x.y), std::exp(x.z)};
+}
 
 struct Scene {
     glm::dvec3 observer, surface, sun;
