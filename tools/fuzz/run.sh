@@ -35,6 +35,7 @@ seed_mesh_loader() {
 
 run_one() {
   local t=$1 work=$here/corpus-run/$t crashes=$here/crashes/$t log=$here/crashes/$t.log dict=()
+  rm -rf "$crashes" # this run's findings only; earlier ones are in the corpus
   mkdir -p "$work" "$crashes"
   cp -n "$here/corpus/$t"/* "$work"/ 2>/dev/null || true
   [ "$t" = mesh_loader ] && seed_mesh_loader "$work"
