@@ -335,7 +335,10 @@ TEST(CliContract, SignalsStopABakeAndAnImportCleanly) {
         for (const std::vector<std::string>& cmd :
              {std::vector<std::string>{"ao", engine, "-o", out + "/engine.glb", "--rule", "lebedev:5810"},
               std::vector<std::string>{"mesh", "convert", obj, "-o", out + "/big.glb"}}) {
-            const CliResult r = skybake::test::run_cli_interrupted(cmd, 0.7, sig);
+            // The import: 0.2 s into the parse (it takes seconds). The bake:
+            // 1.5 s in, after the start and the import, well before its end.
+            const bool import = cmd[0] == "mesh";
+            const CliResult r = skybake::test::run_cli_interrupted(cmd, import ? 0.2 : 1.5, sig, import);
             SCOPED_TRACE(describe(cmd) + (sig == SIGTERM ? " + SIGTERM" : " + SIGINT"));
             EXPECT_EQ(r.exit_code, 128 + sig) << r.err;
             EXPECT_EQ(r.err_lines(), 1) << r.err;

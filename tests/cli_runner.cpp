@@ -28,7 +28,14 @@ std::string temp_dir(const std::string& name) {
 }
 
 namespace {
-CliResult run(const std::vector<std::string>& args, int timeout_s, double signal_after_s, int sig) {
+// Whether process `pid` has a child process now.
+bool has_child(pid_t pid) {
+    std::ifstream children("/proc/" + std::to_string(pid) + "/task/" + std::to_string(pid) + "/children");
+    std::string first;
+    return bool(children >> first);
+}
+
+CliResult run(const std::vector<std::string>& args, int timeout_s, double signal_after_s, int sig, bool after_fork) {
     namespace fs = std::filesystem;
     static int counter = 0;
     const fs::path dir = temp_dir("cli-capture");
@@ -54,6 +61,8 @@ CliResult run(const std::vector<std::string>& args, int timeout_s, double signal
     }
     int status = 0;
     if (signal_after_s > 0.0) {
+        for (int i = 0; after_fork && i < 6000 && !has_child(pid); ++i)
+            usleep(10000); // up to a minute for the CLI to start its parser
         usleep(useconds_t(signal_after_s * 1e6));
         kill(pid, sig);
     }
@@ -74,10 +83,13 @@ CliResult run(const std::vector<std::string>& args, int timeout_s, double signal
 }
 } // namespace
 
-CliResult run_cli(const std::vector<std::string>& args, int timeout_s) { return run(args, timeout_s, 0.0, 0); }
+CliResult run_cli(const std::vector<std::string>& args, int timeout_s) {
+    return run(args, timeout_s, 0.0, 0, false);
+}
 
-CliResult run_cli_interrupted(const std::vector<std::string>& args, double after_s, int sig, int timeout_s) {
-    return run(args, timeout_s, after_s, sig);
+CliResult run_cli_interrupted(const std::vector<std::string>& args, double after_s, int sig, bool after_fork,
+                              int timeout_s) {
+    return run(args, timeout_s, after_s, sig, after_fork);
 }
 
 } // namespace skybake::test

@@ -19,8 +19,11 @@ struct CliResult {
 CliResult run_cli(const std::vector<std::string>& args, int timeout_s = 120);
 
 // Runs the CLI and sends it `sig` after `after_s` seconds (as a user's Ctrl-C
-// or a job scheduler's SIGTERM would).
-CliResult run_cli_interrupted(const std::vector<std::string>& args, double after_s, int sig, int timeout_s = 120);
+// or a job scheduler's SIGTERM would). With after_fork, the clock starts when
+// the CLI has started a child process (the isolated mesh parser), so that the
+// signal lands in the middle of the import however slow the start was.
+CliResult run_cli_interrupted(const std::vector<std::string>& args, double after_s, int sig, bool after_fork = false,
+                              int timeout_s = 120);
 
 // A fresh empty folder under the build tree's temp area, removed by the OS later.
 std::string temp_dir(const std::string& name);

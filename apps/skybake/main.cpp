@@ -70,6 +70,7 @@ std::string unknown_command(CLI::App& app, int argc, char** argv) {
 } // namespace
 
 int main(int argc, char** argv) {
+    skybake::install_interrupt_handlers(); // first: long loops stop cleanly, leaving no output
     CLI::App app{"skybake: precomputed lighting for real-time graphics (neural skies, baked visibility)", "skybake"};
     app.require_subcommand(1);
     app.fallthrough(); // inherited by sub-commands: -q and --threads work after them too
@@ -85,7 +86,6 @@ int main(int argc, char** argv) {
         skybake::set_thread_count(threads);
     });
     skybake::cli::add_all_commands(app);
-    skybake::install_interrupt_handlers(); // long loops stop cleanly, leaving no output
 
     try {
         app.parse(argc, argv);

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "skybake/error.h"
+#include "skybake/interrupt.h"
 
 namespace skybake {
 
@@ -37,6 +38,7 @@ void check_target(const fs::path& target) {
 } // namespace
 
 void write_file_atomic(const fs::path& target, const std::function<void(const fs::path&)>& write) {
+    check_interrupted(); // after SIGINT/SIGTERM nothing more is written
     check_target(target);
     const fs::path tmp = temp_path_beside(target);
     std::error_code ec;
@@ -53,6 +55,10 @@ void write_file_atomic(const fs::path& target, const std::function<void(const fs
     }
     if (!fs::exists(tmp, ec))
         throw Error("writer produced no file", target.string());
+    if (interrupt_signal() != 0) {
+        fs::remove(tmp, ec);
+        check_interrupted();
+    }
     fs::rename(tmp, target, ec);
     if (ec) {
         fs::remove(tmp, ec);
@@ -89,6 +95,7 @@ fs::path OutputSet::stage(const fs::path& target) {
 }
 
 void OutputSet::commit() {
+    check_interrupted(); // the destructor removes the staged files
     std::error_code ec;
     for (const auto& [staging, target] : staged_)
         if (!fs::exists(staging, ec))

@@ -236,6 +236,7 @@ RawImport run_isolated(const std::function<RawImport()>& parse, const std::strin
     int status = 0;
     while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
+    check_interrupted(); // a signal that came before the read blocked
     if (WIFSIGNALED(status)) {
         const int sig = WTERMSIG(status);
         if (sig == SIGALRM)
