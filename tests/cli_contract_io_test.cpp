@@ -170,7 +170,13 @@ TEST(CliContract, EveryNumericFlagRejectsWhatIsNotANumberInRange) {
     // hence the short timeout.
     int cases = 0;
     for (const NumericFlag& f : kNumericFlags) {
+#if defined(SKYBAKE_ASAN)
+        // Under the sanitizers every run costs about a second: one value of
+        // each kind (the validators take the same path for the others).
+        std::vector<std::string> values = {"nan", "-inf", "1e300", "1x", ""};
+#else
         std::vector<std::string> values = {"nan", "NaN", "inf", "-inf", "1e300", "1e400", "abc", "1x", "0x10", ""};
+#endif
         if (!f.negative_ok)
             values.push_back("-1");
         if (!f.zero_ok)

@@ -83,6 +83,12 @@ TEST(Soak, MemoryStaysFlatOverManyCycles) {
     std::printf("soak: %d cycles; resident memory %.1f MiB after cycle %d, %.1f MiB after cycle %d (%+.2f%%); "
                 "checksum %.6g\n",
                 cycles, after_tenth, cycles / 10, at_end, cycles, 100.0 * (at_end / after_tenth - 1.0), checksum);
+#if defined(SKYBAKE_ASAN)
+    // AddressSanitizer keeps freed memory in quarantine (256 MiB by default):
+    // resident memory grows by design there, and LeakSanitizer is the check.
+    (void)after_tenth;
+#else
     EXPECT_LE(at_end, 1.05 * after_tenth);
+#endif
     EXPECT_TRUE(std::isfinite(checksum));
 }

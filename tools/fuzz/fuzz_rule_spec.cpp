@@ -20,8 +20,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // (and is cached on disk), and rules of millions of points take their
     // time to fill: slow by nature, not parser bugs. Counts up to 999,999 and
     // small designs keep every branch of the parser reachable.
-    if (const auto d = spec.find("design:t"); d != std::string::npos && std::atoi(spec.c_str() + d + 8) > 12)
-        return 0;
+    if (const auto d = spec.find("design:"); d != std::string::npos) { // "design:tT" or "design:T"
+        const char* t = spec.c_str() + d + 7;
+        if (std::atoi(*t == 't' ? t + 1 : t) > 12)
+            return 0;
+    }
     int digits = 0;
     for (char c : spec) {
         digits = c >= '0' && c <= '9' ? digits + 1 : 0;
