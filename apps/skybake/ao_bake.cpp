@@ -122,14 +122,14 @@ void run(const AoOptions& o, const CLI::App& sub) {
         save_visibility_bits(files.stage(o.bits), outputs, rule);
     files.commit();
 
+    const std::string device = device_name(*backend);
     if (o.json) {
         nlohmann::json j = {{"input", o.input},
                             {"output", o.output},
                             {"backend", r.backend},
                             {"method", r.method},
                             {"device", std::string(backend->name()) == "cuda" ? "cuda" : "cpu"},
-                            {"gpu", device_name(*backend).empty() ? nlohmann::json(nullptr)
-                                                                  : nlohmann::json(device_name(*backend))},
+                            {"gpu", device.empty() ? nlohmann::json(nullptr) : nlohmann::json(device)},
                             {"rule", r.rule},
                             {"directions", r.directions},
                             {"vertices", r.vertices},
@@ -157,7 +157,6 @@ void run(const AoOptions& o, const CLI::App& sub) {
     for (float a : outputs.ao)
         mean += a;
     mean /= double(std::max<std::size_t>(1, outputs.ao.size()));
-    const std::string device = device_name(*backend);
     info("baked {} vertices ({} triangles) with {} ({} directions, {}{}{}): {} rays in {:.2f} s ({:.1f} Mrays/s), "
          "BVH {:.2f} s",
          r.vertices, r.triangles, r.rule, r.directions, r.backend,

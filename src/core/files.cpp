@@ -18,11 +18,17 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path temp_path_beside(const fs::path& target) {
+// A hidden, unique name beside `target`: ".NAME<tag>-PID-N", plus the
+// target's extension when `keep_extension` (for writers that pick their format
+// by extension).
+fs::path path_beside(const fs::path& target, const char* tag, bool keep_extension) {
     static std::atomic<unsigned> counter{0};
     const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    return dir / fmt::format(".{}.tmp-{}-{}", target.filename().string(), ::getpid(), counter++);
+    return dir / fmt::format(".{}{}-{}-{}{}", keep_extension ? target.stem().string() : target.filename().string(),
+                             tag, ::getpid(), counter++, keep_extension ? target.extension().string() : "");
 }
+
+fs::path temp_path_beside(const fs::path& target) { return path_beside(target, ".tmp", false); }
 
 void check_target(const fs::path& target) {
     if (target.empty())
@@ -69,8 +75,8 @@ void write_file_atomic(const fs::path& target, const std::function<void(const fs
 void write_stream_atomic(const fs::path& target, const std::function<void(std::ostream&)>& write) {
     write_file_atomic(target, [&](const fs::path& tmp) {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) // named after the target: the temporary's name means nothing to the user
-            throw Error(fmt::format("cannot create file: {}", std::strerror(errno)), target.string());
+        if (!out) // write_file_atomic names the target instead of the temporary
+            throw Error(fmt::format("cannot create file: {}", std::strerror(errno)), tmp.string());
         write(out);
         out.flush();
         if (!out)
@@ -86,10 +92,7 @@ OutputSet::~OutputSet() {
 
 fs::path OutputSet::stage(const fs::path& target) {
     check_target(target);
-    static std::atomic<unsigned> counter{0};
-    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-    const fs::path staging =
-        dir / fmt::format(".{}.staged-{}-{}{}", target.stem().string(), ::getpid(), counter++, target.extension().string());
+    const fs::path staging = path_beside(target, ".staged", true);
     staged_.emplace_back(staging, target);
     return staging;
 }
