@@ -30,9 +30,9 @@
 #include "skybake/core.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
-#include "visibility/bake_common.h"
+#include "bake/driver.h"
 #include "visibility/embree/embree_backend.h"
-#include "visibility/shading_hd.h"
+#include "visibility/trace_hd.h"
 
 using namespace skybake;
 
@@ -67,21 +67,25 @@ Scene& scene(int kind, std::uint64_t triangles, const std::string& rule, bool wi
     s.backend.set_mesh(s.mesh, BackFaces::Occlude);
     if (!with_rays)
         return s;
-    // Generate the rays exactly as EmbreeBackend::bake() does.
-    BakeOutputs scratch;
-    const visibility::BakeSetup setup = visibility::prepare_bake(s.mesh, s.rule, BakeOptions{}, scratch);
-    const auto order = visibility::coherent_direction_order(setup.points);
+    // Generate the rays exactly as the bake does (the driver's frames and
+    // visiting order, the Embree tracer's packets).
+    const bake::VisitingRule visit = bake::visiting_rule(s.rule);
+    const bake::VertexRays frames = bake::vertex_rays(s.mesh, BakeOptions{});
+    const float t_max = BakeOptions{}.max_distance;
     for (std::uint32_t v = 0; v < s.mesh.vertex_count(); ++v) {
-        const auto f = visibility::vertex_frame(setup, s.mesh, v);
+        const glm::vec3 origin = frames.origin(s.mesh, v), normal = frames.normals[v];
+        const glm::mat3 rotation = visit.rotation(v);
         int lane = 0;
-        for (std::uint32_t j = 0; j < setup.directions; ++j) {
-            const glm::vec3 x = visibility::rule_direction(f.rotation, setup.rotate, setup.points[order[j]]);
-            if (!visibility::needs_ray(glm::dot(f.normal, x)))
+        for (std::uint32_t j = 0; j < visit.points.size(); ++j) {
+            glm::vec3 x;
+            float c;
+            visibility::vertex_direction(visit.points[j], rotation, visit.rotate, normal, x, c);
+            if (!visibility::needs_ray(c))
                 continue;
             RTCRay r{};
-            r.org_x = f.origin.x, r.org_y = f.origin.y, r.org_z = f.origin.z, r.tnear = 0.0f;
+            r.org_x = origin.x, r.org_y = origin.y, r.org_z = origin.z, r.tnear = 0.0f;
             r.dir_x = x.x, r.dir_y = x.y, r.dir_z = x.z, r.time = 0.0f;
-            r.tfar = setup.t_max, r.mask = 0xffffffffu, r.id = 0, r.flags = 0;
+            r.tfar = t_max, r.mask = 0xffffffffu, r.id = 0, r.flags = 0;
             s.rays.push_back(r);
             if (lane == 0) {
                 s.packets.emplace_back();
@@ -169,7 +173,7 @@ void BM_AoVsBareEmbree(benchmark::State& state) {
             c = bare1(s, occ1);
         }
         BakeOutputs out;
-        s.backend.bake(s.mesh, s.rule, o, out);
+        bake_shading(s.mesh, s.rule, s.backend, o, out);
         if (bake_first) {
             a = bare16(s, occ16);
             c = bare1(s, occ1);
@@ -209,7 +213,7 @@ void run_whole_bake(benchmark::State& state, Scene& s) {
     for (auto _ : state) {
         BakeOutputs out;
         const auto t0 = std::chrono::steady_clock::now();
-        s.backend.bake(s.mesh, s.rule, BakeOptions{}, out);
+        bake_shading(s.mesh, s.rule, s.backend, BakeOptions{}, out);
         state.SetIterationTime(seconds_since(t0));
         build += out.build_seconds;
         trace += out.trace_seconds;

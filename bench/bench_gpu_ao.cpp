@@ -22,6 +22,8 @@
 #include <memory>
 
 #include <benchmark/benchmark.h>
+#include <limits>
+
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
 
@@ -30,7 +32,9 @@
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 #include "skybake/visibility.h"
-#include "visibility/bake_common.h"
+#include "bake/driver.h"
+#include "skybake/bake.h"
+#include "visibility/trace_hd.h"
 #include "visibility/cuda/bvh.h"
 #include "visibility/cuda/cuda_backend.h"
 #include "visibility/embree/embree_backend.h"
@@ -64,20 +68,20 @@ void BM_GpuAo(benchmark::State& state) {
     const SphereRule rule = parse_rule(fmt::format("lebedev:{}", state.range(2)));
     BakeOptions o;
     o.method = TraceMethod(state.range(3));
-    auto gpu = make_visibility_backend("cuda");
+    auto gpu = make_visibility_tracer("cuda", o.method);
     visibility::EmbreeBackend embree;
     double t_gpu = 0, t_cpu = 0, build = 0;
     std::uint64_t rays = 0;
     {
         BakeOutputs warm; // first launch: context creation, module load
-        gpu->bake(m, rule, o, warm);
+        bake_shading(m, rule, *gpu, o, warm);
     }
     for (auto _ : state) {
         BakeOutputs g, e;
-        gpu->bake(m, rule, o, g);
+        bake_shading(m, rule, *gpu, o, g);
         BakeOptions eo = o;
         eo.method = TraceMethod::Bvh;
-        embree.bake(m, rule, eo, e);
+        bake_shading(m, rule, embree, eo, e);
         if (g.rays != e.rays) {
             state.SkipWithError("the cuda and embree bakes traced different rays");
             return;
@@ -137,17 +141,16 @@ void BM_HostTraversal(benchmark::State& state) {
     const visibility::Bvh bvh = visibility::build_bvh(m, state.range(3) != 0);
     visibility::EmbreeBackend embree;
     embree.set_mesh(m, BackFaces::Occlude);
-    BakeOutputs scratch;
-    const visibility::BakeSetup s = visibility::prepare_bake(m, rule, BakeOptions{}, scratch);
+    const bake::VisitingRule visit = bake::visiting_rule(rule);
+    const bake::VertexRays frames = bake::vertex_rays(m, BakeOptions{});
     std::vector<Ray> rays;
     for (std::uint32_t v = 0; v < std::min<std::uint32_t>(2000, std::uint32_t(m.vertex_count())); ++v) {
-        const auto f = visibility::vertex_frame(s, m, v);
-        for (std::uint32_t j = 0; j < s.directions; ++j) {
+        for (const glm::vec3& point : visit.points) {
             glm::vec3 x;
             float c;
-            visibility::vertex_direction(s.sorted_points[j], f.rotation, false, f.normal, x, c);
+            visibility::vertex_direction(point, glm::mat3(1.0f), false, frames.normals[v], x, c);
             if (visibility::needs_ray(c))
-                rays.push_back({f.origin, 0.0f, x, s.t_max});
+                rays.push_back({frames.origin(m, v), 0.0f, x, std::numeric_limits<float>::infinity()});
         }
     }
     double ours = 0, theirs = 0;
@@ -187,8 +190,9 @@ void BM_WarpModel(benchmark::State& state) {
     const Mesh& m = mesh(int(state.range(0)), std::uint64_t(state.range(1)));
     const SphereRule rule = parse_rule(fmt::format("lebedev:{}", state.range(2)));
     const visibility::Bvh bvh = visibility::build_bvh(m);
-    BakeOutputs scratch;
-    const visibility::BakeSetup s = visibility::prepare_bake(m, rule, BakeOptions{}, scratch);
+    const bake::VisitingRule visit = bake::visiting_rule(rule);
+    const bake::VertexRays frames = bake::vertex_rays(m, BakeOptions{});
+    const auto directions = std::uint32_t(visit.points.size());
     const std::uint32_t vertices = std::min<std::uint32_t>(1000, std::uint32_t(m.vertex_count()));
     struct Model {
         double useful = 0, cost = 0, nodes = 0, triangles = 0, rays = 0;
@@ -197,19 +201,20 @@ void BM_WarpModel(benchmark::State& state) {
     auto model = [&](const std::vector<glm::vec3>& points) {
         Model r;
         for (std::uint32_t v = 0; v < vertices; ++v) {
-            const auto f = visibility::vertex_frame(s, m, v);
-            for (std::uint32_t w = 0; w < s.words; ++w) {
+            const glm::vec3 origin = frames.origin(m, v);
+            for (std::uint32_t w = 0; w < visit.words_per_vertex; ++w) {
                 std::uint32_t longest = 0, sum = 0;
-                for (std::uint32_t lane = 0; lane < 32 && 32 * w + lane < s.directions; ++lane) {
+                for (std::uint32_t lane = 0; lane < 32 && 32 * w + lane < directions; ++lane) {
                     glm::vec3 x;
                     float c;
-                    visibility::vertex_direction(points[32 * w + lane], f.rotation, false, f.normal, x, c);
+                    visibility::vertex_direction(points[32 * w + lane], glm::mat3(1.0f), false, frames.normals[v], x,
+                                                 c);
                     if (!visibility::needs_ray(c))
                         continue;
                     visibility::TraversalCounts n;
-                    float t = s.t_max, u, vv;
+                    float t = std::numeric_limits<float>::infinity(), u, vv;
                     std::uint32_t id = kNoHit;
-                    visibility::bvh_trace<true>(bvh.view(), f.origin, x, 0.0f, t, false, id, u, vv, &n);
+                    visibility::bvh_trace<true>(bvh.view(), origin, x, 0.0f, t, false, id, u, vv, &n);
                     const std::uint32_t steps = n.nodes + n.triangles;
                     longest = std::max(longest, steps);
                     sum += steps;
@@ -226,8 +231,8 @@ void BM_WarpModel(benchmark::State& state) {
     Model coherent, plain;
     for (auto _ : state) {
         const auto t0 = std::chrono::steady_clock::now();
-        coherent = model(s.sorted_points);
-        plain = model(s.points);
+        coherent = model(visit.points);
+        plain = model(rule.points_f32());
         state.SetIterationTime(seconds_since(t0));
     }
     state.counters["rays"] = coherent.rays;

@@ -128,8 +128,8 @@ TEST(AoCli, BadInputIsOneLineAndNoOutput) {
     expect_one_line_error(run_cli({"ao", in, "-o", out, "--rule", "lebedev:500"}), 2, "lebedev");
     expect_one_line_error(run_cli({"ao", in, "-o", out, "--rule", "phong:a=4,n=3"}), 2, "Phong");
     if (skybake::cuda_device_count() == 0) { // no GPU, or a build without CUDA: a runtime error
-        expect_one_line_error(run_cli({"ao", in, "-o", out, "--device", "cuda"}), 1, "--device cpu");
-        expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "cuda"}), 1, "--device cpu");
+        expect_one_line_error(run_cli({"ao", in, "-o", out, "--device", "cuda"}), 1, "on the CPU");
+        expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "cuda"}), 1, "on the CPU");
     }
     expect_one_line_error(run_cli({"ao", in, "-o", out, "--method", "per-vertex"}), 2, "--device cuda");
     expect_one_line_error(run_cli({"ao", in, "-o", out, "--device", "cuda", "--method", "octree"}), 2, "--method");

@@ -40,10 +40,12 @@ struct AoOptions {
     bool json = false;
 };
 
-// The GPU a backend runs on ("" for the CPU backends).
-std::string device_name(const VisibilityBackend& backend) {
-    return std::string(backend.name()) == "cuda" ? cuda_device_name() : std::string();
-}
+// API fields of the bake → the flags that set them.
+constexpr std::pair<std::string_view, std::string_view> kBakeFlags[] = {
+    {"max_distance", "--max-distance"}, {"ray_offset", "--offset"}, {"rule", "--rule"},
+    {"method", "--method"},             {"backend", "--backend"},   {"device", "--device cuda"},
+    {"back_faces", "--back-faces"},
+};
 
 nlohmann::json stats(const std::vector<float>& v) {
     if (v.empty())
@@ -98,7 +100,9 @@ void run(const AoOptions& o, const CLI::App& sub) {
         check_output_path(o.preview, {".png", ".exr"}, "--preview");
     if (!o.bits.empty())
         check_output_path(o.bits, {}, "--bits");
-    const auto backend = make_visibility_backend(backend_id); // no GPU: a runtime error, exit 1
+    const FlagNames flags = kBakeFlags;
+    // No GPU: a runtime error, exit 1.
+    const auto tracer = with_flag_names(flags, [&] { return make_visibility_tracer(backend_id, method); });
 
     BakeOptions b;
     b.max_distance = float(o.max_distance);
@@ -110,7 +114,8 @@ void run(const AoOptions& o, const CLI::App& sub) {
 
     Mesh mesh = load_mesh(o.input);
     BakeOutputs outputs;
-    const AoBakeReport r = bake_ambient_occlusion(mesh, rule, *backend, b, &outputs);
+    const AoBakeReport r =
+        with_flag_names(flags, [&] { return bake_ambient_occlusion(mesh, rule, *tracer, b, &outputs); });
 
     // Every output is staged, then all are committed together: a failure in
     // any one of them leaves none written.
@@ -122,13 +127,13 @@ void run(const AoOptions& o, const CLI::App& sub) {
         save_visibility_bits(files.stage(o.bits), outputs, rule);
     files.commit();
 
-    const std::string device = device_name(*backend);
+    const std::string device = tracer->device_name();
     if (o.json) {
         nlohmann::json j = {{"input", o.input},
                             {"output", o.output},
                             {"backend", r.backend},
                             {"method", r.method},
-                            {"device", std::string(backend->name()) == "cuda" ? "cuda" : "cpu"},
+                            {"device", device.empty() ? "cpu" : "cuda"},
                             {"gpu", device.empty() ? nlohmann::json(nullptr) : nlohmann::json(device)},
                             {"rule", r.rule},
                             {"directions", r.directions},

@@ -6,7 +6,10 @@
 
 #include <cstdint>
 #include <initializer_list>
+#include <span>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <utility>
 
 #include <CLI/CLI.hpp>
@@ -49,6 +52,25 @@ auto parse_flag(const char* flag, F&& parse) -> decltype(parse()) {
         throw;
     } catch (const Error& e) {
         throw UsageError(e.message(), flag);
+    }
+}
+
+// The library names the API field at fault (Error::where(), e.g.
+// "max_distance"); the CLI speaks of flags. Runs f, and rethrows an Error
+// whose where() is a field of `flags` ({field, flag} pairs) as the same Error
+// naming the flag, so the user reads "(--max-distance)".
+using FlagNames = std::span<const std::pair<std::string_view, std::string_view>>;
+template <class F>
+auto with_flag_names(FlagNames flags, F&& f) -> decltype(f()) {
+    try {
+        return f();
+    } catch (const UsageError&) {
+        throw;
+    } catch (const Error& e) {
+        for (const auto& [field, flag] : flags)
+            if (e.where() == field)
+                throw Error(e.message(), std::string(flag));
+        throw;
     }
 }
 

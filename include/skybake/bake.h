@@ -2,6 +2,9 @@
 // normals (seed 002: Svistunov, GPU computation of shading coefficients).
 //
 // [SECTION] Definitions
+// [SECTION] Bake options
+// [SECTION] Bake outputs
+// [SECTION] The bake driver
 // [SECTION] Bake a mesh
 // [SECTION] Reduction of stored visibility bits
 // [SECTION] Visibility bits file
@@ -13,6 +16,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -37,7 +41,164 @@ namespace skybake {
 //   bent normal        b  = normalise(∫ V (n·x)+ x dμ): the cosine-weighted mean
 //                      unoccluded direction (n when nothing is visible)
 // All three are 1 / n for a vertex that sees the whole hemisphere. A sphere rule
-// {x_k, w_k} replaces the integrals by sums (skybake/visibility.h, BakeOptions).
+// {x_k, w_k} replaces the integrals by sums ([SECTION] Bake options).
+
+// [SECTION] Bake options --------------------------------------------------------------
+//
+// For every vertex p with unit normal n, and every direction x_k of a sphere
+// rule {x_k, w_k} (turned by the vertex's random rotation when the rule asks
+// for it), the bake decides the seed's visibility
+//     V_p(x_k) = 1  if n·x_k ≥ 0 and the ray from p along x_k leaves the mesh,
+//                0  otherwise (below the horizon, or blocked),
+// and sums
+//     AO = Σ_k w_k 4 (n·x_k)+ V_k,     A = Σ_k w_k 2 H(n·x_k) V_k,
+//     bent normal = normalise(Σ_k w_k (n·x_k)+ V_k x_k),
+// with H = 1 above the horizon, ½ on it (n·x_k = 0 exactly: symmetric rules
+// put whole orbits there for axis-aligned normals; the midpoint value of the
+// step keeps A unbiased) and 0 below. Directions below the horizon need no ray.
+// A ray starts at
+//     origin = p + offset·(n + u),   t in (0, max_distance],
+// so that it does not hit the triangles around p itself. u is zero for most
+// vertices; for a vertex on a mesh border or where two surfaces meet (its
+// triangles' area-weighted mean centroid is off the vertex) it is the unit
+// tangent towards that centroid: a floor vertex at the foot of a wall, or the
+// bottom edge of a box standing on the ground, then starts its rays just off
+// the other surface instead of on it.
+
+// The default offset is this fraction of the mesh's bounding-box diagonal:
+// scale-aware, so a bake does not change when the mesh is scaled or moved.
+inline constexpr float kDefaultRayOffsetScale = 1e-4f;
+
+struct BakeOptions {
+    // Occluders further than this from the ray origin are ignored, in mesh units.
+    // Infinity (the default) means unlimited; must be > 0.
+    float max_distance = std::numeric_limits<float>::infinity();
+    // Distance the ray origin is moved along the vertex normal (and, on borders
+    // and creases, towards the vertex's triangles), in mesh units.
+    // Negative (the default): kDefaultRayOffsetScale × bounding-box diagonal.
+    float ray_offset = -1.0f;
+    BackFaces back_faces = BackFaces::Occlude;
+    // false (the seed's definition): the sums above, clamped to [0, 1] (rules
+    //   with negative weights, and the rule's own error for the clamped cosine,
+    //   can push them slightly out).
+    // true: divide each sum by its value with V ≡ 1, so that an unoccluded
+    //   vertex gets exactly 1 whatever the rule (a ratio estimator).
+    bool normalize = false;
+    // Keep the visibility bits (BakeOutputs::visibility_bits).
+    bool store_bits = false;
+    // How blockers are found: must be the tracer's method (VisibilityTracer::method());
+    // the by-name bake_ambient_occlusion() creates the tracer with it.
+    TraceMethod method = TraceMethod::Bvh;
+};
+
+// The ray offset a bake uses for this mesh: options.ray_offset if ≥ 0, else
+// kDefaultRayOffsetScale × the bounding-box diagonal.
+float resolve_ray_offset(const Mesh& mesh, const BakeOptions& options);
+
+// [SECTION] Bake outputs ----------------------------------------------------------------
+//
+// The visibility bits are in the layout of skybake/visibility.h ([SECTION]
+// Visibility words).
+struct BakeOutputs {
+    // One entry per vertex.
+    std::vector<float> ao;              // cosine-weighted visibility V0 (seed 002, def. 1), in [0, 1]
+    std::vector<float> shading;         // uniform shading coefficient A (seed 002, def. 2), in [0, 1]
+    std::vector<glm::vec3> bent_normal; // unit; normalised Σ_k w_k V_k (n·x_k)+ x_k, or n when nothing is visible
+    // Visibility bits (empty unless BakeOptions::store_bits).
+    std::uint32_t directions = 0;       // K, the rule's point count
+    std::uint32_t words_per_vertex = 0; // ceil(K / 32)
+    std::vector<std::uint32_t> visibility_bits;
+    // Statistics.
+    std::uint64_t rays = 0;             // rays traced (directions on or above the horizon)
+    std::uint64_t clamped_vertices = 0; // vertices whose AO or A sum left [0, 1] and was clamped
+    float ray_offset = 0.0f;            // offset used, mesh units
+    double build_seconds = 0.0;         // acceleration structure
+    double trace_seconds = 0.0;         // rays and reduction
+
+    // V of direction k at vertex v (store_bits only).
+    bool visible(std::size_t vertex, std::size_t direction) const {
+        return (visibility_bits[vertex * words_per_vertex + direction / 32] >> (direction % 32)) & 1u;
+    }
+};
+
+
+// [SECTION] The bake driver -------------------------------------------------------------
+//
+//   mesh ─► driver ─► tracer ─► visibility words ─► reduction ─► attributes ─► glTF
+//
+// bake_visibility() is the one bake loop. It checks the inputs, computes each
+// vertex's ray origin and normal (and rotation), orders the rule's directions
+// coherently, cuts the vertices into chunks that fit the tracer's and its own
+// memory budget, has the tracer fill each chunk's visibility words and hands
+// them to a reduction, with progress, timing and statistics. Tracers
+// (skybake/visibility.h) know nothing of what the words become; reductions
+// know nothing of how they were traced.
+
+// The rule of a bake as reductions see it: single precision, visiting order.
+struct VisibilityRule {
+    std::span<const glm::vec3> points;    // points[j] is rule direction order[j], unit
+    std::span<const float> weights;       // weights[j] of points[j]
+    std::span<const std::uint32_t> order; // visiting position j → rule index k
+    std::uint32_t words_per_vertex = 0;
+    bool rotate = false;                  // per-vertex rotations (VisibilityChunk::rotations)
+};
+
+// One traced chunk, as a reduction receives it.
+struct VisibilityChunk {
+    std::uint32_t first = 0, count = 0;       // mesh vertices [first, first + count)
+    std::span<const glm::vec3> normals;       // unit, count
+    std::span<const glm::mat3> rotations;     // count when the rule rotates, else empty
+    std::span<const std::uint32_t> words;     // count × words_per_vertex; empty when only device_words is set
+    const std::uint32_t* device_words = nullptr; // the same words in GPU memory (GPU tracers), or nullptr
+};
+
+class VisibilityReduction {
+public:
+    virtual ~VisibilityReduction() = default;
+    // Before the first chunk: the rule and the vertex count.
+    virtual void begin(const VisibilityRule& rule, std::size_t vertices) = 0;
+    // Whether reduce() can read VisibilityChunk::device_words alone, so that
+    // a GPU tracer need not copy the words back.
+    virtual bool reduces_on_device() const { return false; }
+    // Reduces one chunk (chunks come in order, one at a time). Returns the
+    // chunk's rays: its directions on or above each vertex's horizon.
+    virtual std::uint64_t reduce(const VisibilityChunk& chunk) = 0;
+};
+
+struct VisibilityBakeStats {
+    std::uint64_t rays = 0;     // directions on or above the horizons, summed over vertices
+    float ray_offset = 0.0f;    // mesh units
+    std::uint32_t chunks = 0;   // trace() calls
+    double build_seconds = 0.0; // tracer's acceleration structure
+    double trace_seconds = 0.0; // tracing and reduction
+};
+
+// Runs the bake. mesh needs unit normals (mesh.normals, one per vertex).
+// Throws skybake::Error on an invalid mesh ("mesh"), rule ("rule") or option
+// (named by its BakeOptions field: "max_distance", "ray_offset", "method"),
+// and skybake::Interrupted after SIGINT or SIGTERM.
+VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, VisibilityTracer& tracer,
+                                    const BakeOptions& options, VisibilityReduction& reduction);
+
+// The reduction behind bake_ambient_occlusion(): AO, A and the bent normal of
+// every vertex into `out` (and the words, with options.store_bits).
+class ShadingReduction final : public VisibilityReduction {
+public:
+    ShadingReduction(BakeOutputs& out, bool normalize, bool store_bits);
+    void begin(const VisibilityRule& rule, std::size_t vertices) override;
+    bool reduces_on_device() const override;
+    std::uint64_t reduce(const VisibilityChunk& chunk) override;
+
+private:
+    BakeOutputs& out_;
+    bool normalize_, store_bits_;
+    VisibilityRule rule_;
+};
+
+// The whole AO bake (see [SECTION] Bake options) into `out`: bake_visibility()
+// with a ShadingReduction.
+void bake_shading(const Mesh& mesh, const SphereRule& rule, VisibilityTracer& tracer, const BakeOptions& options,
+                  BakeOutputs& out);
 
 // [SECTION] Bake a mesh ------------------------------------------------------------------
 
@@ -65,9 +226,9 @@ struct AoBakeReport {
 // Computes area-weighted normals first when the mesh has none. `outputs`, when
 // given, receives the raw backend outputs (with the visibility bits when
 // options.store_bits). Throws skybake::Error on an invalid mesh, rule or options.
-AoBakeReport bake_ambient_occlusion(Mesh& mesh, const SphereRule& rule, VisibilityBackend& backend,
+AoBakeReport bake_ambient_occlusion(Mesh& mesh, const SphereRule& rule, VisibilityTracer& tracer,
                                     const BakeOptions& options = {}, BakeOutputs* outputs = nullptr);
-// Same, creating the backend by name ("embree", "brute").
+// Same, creating the tracer by name ("embree", "brute", "cuda") with options.method.
 AoBakeReport bake_ambient_occlusion(Mesh& mesh, const SphereRule& rule, const std::string& backend = "embree",
                                     const BakeOptions& options = {}, BakeOutputs* outputs = nullptr);
 

@@ -1,21 +1,30 @@
-// skybake/visibility.h: ray visibility against a triangle mesh, and the
-// per-vertex visibility bake behind the shading coefficients of seed 002
-// (Svistunov, GPU computation of shading coefficients).
+// skybake/visibility.h: what a triangle mesh hides, as ray queries and as the
+// bit-packed per-vertex visibility that the bakes reduce (seed 002: Svistunov,
+// GPU computation of shading coefficients).
 //
 // [SECTION] Rays and hits
-// [SECTION] Bake options
-// [SECTION] Bake outputs and the bit-packed visibility layout
+// [SECTION] Ray queries
+// [SECTION] Visibility words
+// [SECTION] Visibility tracers
 // [SECTION] Backends
 //
-// One interface, several backends (docs/baking.md):
+// Two interfaces, because not every backend can answer every question:
+//   RayQueries        occluded() and intersect() for arbitrary rays
+//   VisibilityTracer  for a chunk of vertices and a sphere rule, the
+//                     visibility words of [SECTION] Visibility words
+// The bake driver (skybake/bake.h) owns everything around trace(): input
+// checks, ray origins, the direction order, chunking, progress and timing;
+// reductions (AO, SH transfer, ...) turn the words into vertex attributes.
+//
+// Backends (docs/baking.md):
 //   "embree"  Intel Embree 3 on the CPU, TBB-parallel (default): 16-ray packets
 //             for rules of 1000+ directions, single rays for smaller ones
 //   "brute"   every ray against every triangle, in double precision: a test
 //             oracle for small meshes only
 //   "cuda"    NVIDIA GPUs (builds that have CUDA, machines that have a GPU): a
 //             BVH built on the CPU with Embree's builder, walked by one GPU
-//             thread per ray; visibility packed into bits on the GPU and
-//             reduced there. Also the seed's brute-force methods (TraceMethod)
+//             thread per ray. Also the seed's brute-force methods (TraceMethod)
+// Each implements both interfaces.
 //
 // Frames and units: everything is in the mesh's world space and its own length
 // unit ("mesh units"); directions are unit vectors in the same frame.
@@ -28,12 +37,12 @@
 #include <string>
 #include <vector>
 
+#include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
 
 namespace skybake {
 
 struct Mesh;
-struct SphereRule;
 
 // [SECTION] Rays and hits ------------------------------------------------------------
 
@@ -78,96 +87,14 @@ const char* trace_method_name(TraceMethod method); // "bvh", "per-vertex", "per-
 // Parses a name above; throws skybake::Error otherwise.
 TraceMethod parse_trace_method(const std::string& text);
 
-// [SECTION] Bake options --------------------------------------------------------------
-//
-// For every vertex p with unit normal n, and every direction x_k of a sphere
-// rule {x_k, w_k} (turned by the vertex's random rotation when the rule asks
-// for it), the bake decides the seed's visibility
-//     V_p(x_k) = 1  if n·x_k ≥ 0 and the ray from p along x_k leaves the mesh,
-//                0  otherwise (below the horizon, or blocked),
-// and sums
-//     AO = Σ_k w_k 4 (n·x_k)+ V_k,     A = Σ_k w_k 2 H(n·x_k) V_k,
-//     bent normal = normalise(Σ_k w_k (n·x_k)+ V_k x_k),
-// with H = 1 above the horizon, ½ on it (n·x_k = 0 exactly: symmetric rules
-// put whole orbits there for axis-aligned normals; the midpoint value of the
-// step keeps A unbiased) and 0 below. Directions below the horizon need no ray.
-// A ray starts at
-//     origin = p + offset·(n + u),   t in (0, max_distance],
-// so that it does not hit the triangles around p itself. u is zero for most
-// vertices; for a vertex on a mesh border or where two surfaces meet (its
-// triangles' area-weighted mean centroid is off the vertex) it is the unit
-// tangent towards that centroid: a floor vertex at the foot of a wall, or the
-// bottom edge of a box standing on the ground, then starts its rays just off
-// the other surface instead of on it.
 
-// The default offset is this fraction of the mesh's bounding-box diagonal:
-// scale-aware, so a bake does not change when the mesh is scaled or moved.
-inline constexpr float kDefaultRayOffsetScale = 1e-4f;
+// [SECTION] Ray queries ----------------------------------------------------------------
 
-struct BakeOptions {
-    // Occluders further than this from the ray origin are ignored, in mesh units.
-    // Infinity (the default) means unlimited; must be > 0.
-    float max_distance = std::numeric_limits<float>::infinity();
-    // Distance the ray origin is moved along the vertex normal (and, on borders
-    // and creases, towards the vertex's triangles), in mesh units.
-    // Negative (the default): kDefaultRayOffsetScale × bounding-box diagonal.
-    float ray_offset = -1.0f;
-    BackFaces back_faces = BackFaces::Occlude;
-    // false (the seed's definition): the sums above, clamped to [0, 1] (rules
-    //   with negative weights, and the rule's own error for the clamped cosine,
-    //   can push them slightly out).
-    // true: divide each sum by its value with V ≡ 1, so that an unoccluded
-    //   vertex gets exactly 1 whatever the rule (a ratio estimator).
-    bool normalize = false;
-    // Keep the visibility bits (BakeOutputs::visibility_bits).
-    bool store_bits = false;
-    // The cuda backend's method; the CPU backends accept only TraceMethod::Bvh.
-    TraceMethod method = TraceMethod::Bvh;
-};
-
-// The ray offset a bake uses for this mesh: options.ray_offset if ≥ 0, else
-// kDefaultRayOffsetScale × the bounding-box diagonal.
-float resolve_ray_offset(const Mesh& mesh, const BakeOptions& options);
-
-// [SECTION] Bake outputs and the bit-packed visibility layout -------------------------
-//
-// Visibility bits, seed 002's compact form (the seed uses uint16 words of 16
-// directions; skybake uses uint32 words of 32): vertex v owns words_per_vertex =
-// ceil(K / 32) consecutive words starting at v·words_per_vertex; the bit of rule
-// direction k is bit (k mod 32) (least significant first) of word k / 32. A set
-// bit means V = 1 (visible: not below the horizon, and unblocked). Unused high bits of
-// a vertex's last word are 0. Direction k is the rule's k-th point, turned by the
-// vertex's rotation when the rule has "+rotate". Bits below the horizon are 0;
-// bits exactly on it hold the grazing ray's answer.
-struct BakeOutputs {
-    // One entry per vertex.
-    std::vector<float> ao;              // cosine-weighted visibility V0 (seed 002, def. 1), in [0, 1]
-    std::vector<float> shading;         // uniform shading coefficient A (seed 002, def. 2), in [0, 1]
-    std::vector<glm::vec3> bent_normal; // unit; normalised Σ_k w_k V_k (n·x_k)+ x_k, or n when nothing is visible
-    // Visibility bits (empty unless BakeOptions::store_bits).
-    std::uint32_t directions = 0;       // K, the rule's point count
-    std::uint32_t words_per_vertex = 0; // ceil(K / 32)
-    std::vector<std::uint32_t> visibility_bits;
-    // Statistics.
-    std::uint64_t rays = 0;             // rays traced (directions on or above the horizon)
-    std::uint64_t clamped_vertices = 0; // vertices whose AO or A sum left [0, 1] and was clamped
-    float ray_offset = 0.0f;            // offset used, mesh units
-    double build_seconds = 0.0;         // acceleration structure
-    double trace_seconds = 0.0;         // rays and reduction
-
-    // V of direction k at vertex v (store_bits only).
-    bool visible(std::size_t vertex, std::size_t direction) const {
-        return (visibility_bits[vertex * words_per_vertex + direction / 32] >> (direction % 32)) & 1u;
-    }
-};
-
-// [SECTION] Backends -----------------------------------------------------------------------
-
-class VisibilityBackend {
+class RayQueries {
 public:
-    virtual ~VisibilityBackend() = default;
+    virtual ~RayQueries() = default;
 
-    // "embree", "brute", ...
+    // "embree", "brute", "cuda"
     virtual const char* name() const = 0;
 
     // Builds the acceleration structure for mesh.positions and mesh.indices,
@@ -182,22 +109,94 @@ public:
 
     // Closest hits against the current mesh; hits.size() must equal rays.size().
     virtual void intersect(std::span<const Ray> rays, std::span<RayHit> hits) const = 0;
-
-    // The whole vertex × rule bake (see [SECTION] Bake options): calls
-    // set_mesh(mesh, options.back_faces), then fills every field of `out`.
-    // The mesh needs unit normals (mesh.normals, one per vertex). Results depend
-    // only on the inputs, not on the thread count. Throws skybake::Error on an
-    // invalid mesh, an empty rule or bad options.
-    virtual void bake(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options, BakeOutputs& out);
 };
 
-// Names accepted by make_visibility_backend() in this build ("cuda" only in
-// builds with CUDA; it still needs a GPU at run time).
+// [SECTION] Visibility words -------------------------------------------------------------
+//
+// Seed 002's compact form of visibility (the seed uses uint16 words of 16
+// directions; skybake uses uint32 words of 32). For a rule of K directions,
+// vertex v owns words_per_vertex = ceil(K / 32) consecutive words starting at
+// v·words_per_vertex; the bit of rule direction k is bit (k mod 32) (least
+// significant first) of word k / 32. A set bit means V = 1: the direction is not
+// below the vertex's horizon (n·x ≥ 0) and the ray from the vertex's ray origin
+// along it leaves the mesh. Unused high bits of a vertex's last word are 0.
+// Direction k is the rule's k-th point, turned by the vertex's rotation when
+// the rule has "+rotate". Bits below the horizon are 0; bits exactly on it hold
+// the grazing ray's answer.
+
+inline constexpr std::uint32_t visibility_words(std::uint32_t directions) { return (directions + 31u) / 32u; }
+
+// [SECTION] Visibility tracers ---------------------------------------------------------------
+
+// The rule of one bake as a tracer sees it, fixed for the whole bake. The
+// directions come in the driver's visiting order, in which consecutive
+// directions are close on the sphere (coherent packets and warps).
+struct TraceRule {
+    std::span<const glm::vec3> points;   // visiting order: points[j] is rule direction order[j], unit
+    std::span<const std::uint32_t> order; // a permutation of 0 ... K−1
+    std::uint32_t words_per_vertex = 0;  // visibility_words(K)
+    bool rotate = false;                 // TraceChunk::rotations turn the points, vertex by vertex
+    float t_max = std::numeric_limits<float>::infinity(); // occluders further than this are ignored, mesh units
+};
+
+// One chunk of vertices. Every span has `count` entries (words: count ×
+// words_per_vertex) except rotations, which is empty unless the rule rotates.
+struct TraceChunk {
+    std::uint32_t first = 0;                // index of the chunk's first vertex in the mesh
+    std::uint32_t count = 0;
+    std::span<const glm::vec3> origins;     // ray origins, mesh units
+    std::span<const glm::vec3> normals;     // unit: the horizon of each vertex
+    std::span<const glm::mat3> rotations;   // direction k of vertex v is rotations[v]·x_k
+    // Output, in the layout of [SECTION] Visibility words: trace() writes every
+    // word. May be empty for a tracer with device_words_supported(): the
+    // caller then reads VisibilityTracer::device_words() instead.
+    std::span<std::uint32_t> words;
+};
+
+class VisibilityTracer {
+public:
+    virtual ~VisibilityTracer() = default;
+
+    // "embree", "brute", "cuda"
+    virtual const char* name() const = 0;
+    // How blockers are found; TraceMethod::Bvh except for the cuda backend's
+    // brute-force methods.
+    virtual TraceMethod method() const { return TraceMethod::Bvh; }
+    // The GPU's name for a GPU tracer, empty on the CPU.
+    virtual std::string device_name() const { return {}; }
+
+    // As RayQueries::set_mesh().
+    virtual void set_mesh(const Mesh& mesh, BackFaces back_faces = BackFaces::Occlude) = 0;
+    // Called once per bake, after set_mesh() and before trace(); `rule` stays
+    // valid until the next call. Returns the most vertices one trace() call
+    // may take (the tracer's memory and launch limits).
+    virtual std::uint32_t set_rule(const TraceRule& rule) = 0;
+    // Fills chunk.words (and the device words, for a GPU tracer). The result
+    // of a vertex depends on that vertex's inputs alone, not on the chunking
+    // or the thread count. Throws skybake::Error on a device failure, and
+    // skybake::Interrupted after SIGINT or SIGTERM.
+    virtual void trace(const TraceChunk& chunk) = 0;
+    // Whether the tracer keeps each chunk's words in GPU memory too, so that
+    // TraceChunk::words may be empty.
+    virtual bool device_words_supported() const { return false; }
+    // A GPU tracer's copy of the last chunk's words in device memory (same
+    // layout), or nullptr: a reduction with a CUDA kernel can read them there.
+    virtual const std::uint32_t* device_words() const { return nullptr; }
+};
+
+// [SECTION] Backends -----------------------------------------------------------------------
+
+// Names accepted by the factories below in this build ("cuda" only in builds
+// with CUDA; it still needs a GPU at run time).
 std::vector<std::string> visibility_backend_names();
 
-// Creates a backend by name. Throws skybake::Error for an unknown name, and for
-// "cuda" in a build without CUDA or on a machine without a CUDA device.
-std::unique_ptr<VisibilityBackend> make_visibility_backend(const std::string& name);
+// Create a backend by name. Throw skybake::Error (where: "backend") for an
+// unknown name, and for "cuda" in a build without CUDA or on a machine
+// without a CUDA device; make_visibility_tracer() also for a method the
+// backend does not have (where: "method").
+std::unique_ptr<RayQueries> make_ray_queries(const std::string& name);
+std::unique_ptr<VisibilityTracer> make_visibility_tracer(const std::string& name,
+                                                         TraceMethod method = TraceMethod::Bvh);
 
 // The brute-force backend refuses meshes with more triangles than this.
 inline constexpr std::size_t kBruteForceMaxTriangles = 20'000;

@@ -21,7 +21,7 @@
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 #include "visibility/cuda/bvh.h"
-#include "visibility/cuda/test_scenes.h"
+#include "bake/cuda_bake_test_util.h"
 
 using namespace skybake;
 

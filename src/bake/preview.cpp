@@ -20,13 +20,13 @@ Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
         throw Error("the mesh has no baked 'ao' attribute to preview; bake it first", "mesh");
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
         throw Error(fmt::format("preview size {}x{} is out of range; use 1 to 16384 pixels per side", o.width, o.height),
-                    "--preview-size");
+                    "width, height");
     if (o.samples < 1 || o.samples > 8)
-        throw Error(fmt::format("{} samples per pixel axis is out of range; use 1 to 8", o.samples));
+        throw Error(fmt::format("{} samples per pixel axis is out of range; use 1 to 8", o.samples), "samples");
     if (!(o.fov_y_deg > 1.0f && o.fov_y_deg < 170.0f))
-        throw Error(fmt::format("field of view {} degrees is out of range; use 1 to 170", o.fov_y_deg));
+        throw Error(fmt::format("field of view {} degrees is out of range; use 1 to 170", o.fov_y_deg), "fov_y_deg");
 
-    const auto backend = make_visibility_backend("embree");
+    const auto backend = make_ray_queries("embree");
     backend->set_mesh(mesh, BackFaces::Occlude);
 
     // Camera framing the bounding sphere of the bounding box, y up.

@@ -11,6 +11,7 @@
 #include "core/parallel.h"
 #include "skybake/error.h"
 #include "skybake/mesh.h"
+#include "visibility/query_tracer.h"
 #include "visibility/triangle_hd.h"
 
 namespace skybake::visibility {
@@ -21,7 +22,7 @@ void BruteForceBackend::set_mesh(const Mesh& mesh, BackFaces back_faces) {
         throw Error(fmt::format("the brute-force backend is a test oracle for meshes of up to {} triangles; this mesh "
                                 "has {}: use the embree backend",
                                 kBruteForceMaxTriangles, mesh.triangle_count()),
-                    "--backend brute");
+                    "backend");
     triangles_.clear();
     triangles_.reserve(mesh.triangle_count());
     for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
@@ -72,5 +73,12 @@ void BruteForceBackend::intersect(std::span<const Ray> rays, std::span<RayHit> h
         }
     });
 }
+
+std::uint32_t BruteForceBackend::set_rule(const TraceRule& rule) {
+    rule_ = rule;
+    return 0xffffffffu;
+}
+
+void BruteForceBackend::trace(const TraceChunk& chunk) { trace_with_queries(*this, rule_, chunk); }
 
 } // namespace skybake::visibility

@@ -15,8 +15,8 @@
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 #include "skybake/visibility.h"
-#include "visibility/bake_common.h"
-#include "visibility/shading_hd.h"
+#include "visibility/cuda/emulated_tracer.h"
+#include "visibility/trace_hd.h"
 #include "visibility/triangle_hd.h"
 
 using namespace skybake;
@@ -87,8 +87,8 @@ TEST(Visibility, EmbreeAgreesWithBruteForceOnRandomRays) {
     for (std::uint32_t seed = 1; seed <= 4; ++seed) {
         const Mesh m = random_mesh(seed, 200);
         const auto rays = random_rays(seed, 20000);
-        auto embree = make_visibility_backend("embree");
-        auto brute = make_visibility_backend("brute");
+        auto embree = make_ray_queries("embree");
+        auto brute = make_ray_queries("brute");
         embree->set_mesh(m);
         brute->set_mesh(m);
         std::vector<std::uint8_t> a(rays.size()), b(rays.size());
@@ -120,101 +120,6 @@ TEST(Visibility, EmbreeAgreesWithBruteForceOnRandomRays) {
     }
 }
 
-TEST(Visibility, BakeAgreesWithBruteForceOnRandomMeshes) {
-    // Small rules go ray by ray, large ones (≥ 1000 directions) in packets.
-    for (const char* spec : {"lebedev:110", "fibonacci:200+rotate=5", "mc:300,seed=3+rotate", "lebedev:1202",
-                             "fibonacci:1500+rotate"}) {
-        const SphereRule rule = parse_rule(spec);
-        for (std::uint32_t seed = 11; seed <= (rule.size() < 1000 ? 12u : 11u); ++seed) {
-            const Mesh m = random_mesh(seed, rule.size() < 1000 ? 120 : 60);
-            BakeOptions o;
-            o.store_bits = true;
-            BakeOutputs a, b;
-            make_visibility_backend("embree")->bake(m, rule, o, a);
-            make_visibility_backend("brute")->bake(m, rule, o, b);
-            ASSERT_EQ(a.rays, b.rays) << "the same directions are above the horizon";
-            std::size_t bit_diff = 0;
-            for (std::size_t i = 0; i < a.visibility_bits.size(); ++i)
-                bit_diff += std::size_t(__builtin_popcount(a.visibility_bits[i] ^ b.visibility_bits[i]));
-            EXPECT_LE(double(bit_diff), 1e-4 * double(a.rays) + 2) << spec << " seed " << seed;
-            double worst = 0;
-            for (std::size_t v = 0; v < m.vertex_count(); ++v) {
-                worst = std::max(worst, double(std::abs(a.ao[v] - b.ao[v])));
-                // Identical bits give identical coefficients: same reduction, same order.
-                if (std::equal(a.visibility_bits.begin() + std::ptrdiff_t(v * a.words_per_vertex),
-                               a.visibility_bits.begin() + std::ptrdiff_t((v + 1) * a.words_per_vertex),
-                               b.visibility_bits.begin() + std::ptrdiff_t(v * a.words_per_vertex))) {
-                    EXPECT_EQ(a.ao[v], b.ao[v]);
-                    EXPECT_EQ(a.shading[v], b.shading[v]);
-                    EXPECT_EQ(a.bent_normal[v], b.bent_normal[v]);
-                }
-            }
-            // One flipped direction changes AO by at most 4 max(w) ≈ 4/K.
-            EXPECT_LE(worst, 4.0 * 2.0 / double(rule.size()) + 1e-6) << spec;
-        }
-    }
-}
-
-TEST(Visibility, UnoccludedVertexMatchesTheRule) {
-    // A lone triangle facing up: its vertices see the whole upper hemisphere.
-    Mesh m;
-    m.positions = {{0, 0, 0}, {0, 0, 1}, {1, 0, 0}};
-    m.indices = {0, 1, 2};
-    compute_normals(m);
-    ASSERT_NEAR(m.normals[0].y, 1.0f, 1e-6f);
-    const SphereRule rule = parse_rule("lebedev:5810");
-    // The rule's own sums for n = +y, with V ≡ 1 above the horizon.
-    // Directions exactly on the horizon (y = 0: whole Lebedev orbits) count half in A.
-    double ao = 0, a = 0;
-    std::size_t up = 0;
-    for (std::size_t k = 0; k < rule.size(); ++k)
-        if (float(rule.points[k].y) >= 0.0f) {
-            ao += 4.0 * rule.weights[k] * rule.points[k].y;
-            a += (rule.points[k].y > 0.0 ? 2.0 : 1.0) * rule.weights[k];
-            ++up;
-        }
-    for (const char* name : {"embree", "brute"}) {
-        BakeOutputs out;
-        BakeOptions o;
-        o.store_bits = true;
-        make_visibility_backend(name)->bake(m, rule, o, out);
-        EXPECT_EQ(out.rays, 3 * up) << name;
-        for (std::size_t v = 0; v < 3; ++v) {
-            EXPECT_NEAR(out.ao[v], std::min(ao, 1.0), 1e-5) << name;
-            EXPECT_NEAR(out.shading[v], std::min(a, 1.0), 1e-5) << name;
-            EXPECT_NEAR(out.bent_normal[v].y, 1.0f, 1e-5f) << name;
-            // Every direction on or above the horizon is visible, none below.
-            for (std::size_t k = 0; k < rule.size(); ++k)
-                EXPECT_EQ(out.visible(v, k), float(rule.points[k].y) >= 0.0f) << name << " k " << k;
-        }
-        // Unused high bits of the last word stay 0 (5810 = 181·32 + 18).
-        EXPECT_EQ(out.words_per_vertex, 182u);
-        EXPECT_EQ(out.visibility_bits[181] >> 18, 0u);
-    }
-    // The rule's clamped-cosine error is the AO error of an open vertex: tiny
-    // for 5810 points; with the half weights on the horizon A is exact (the
-    // rule is symmetric under y -> -y).
-    EXPECT_NEAR(ao, 1.0, 2e-4);
-    EXPECT_NEAR(a, 1.0, 1e-12);
-}
-
-TEST(Visibility, NormalizedBakeOfOpenVertexIsExactlyOne) {
-    Mesh m;
-    m.positions = {{0, 0, 0}, {0, 0, 1}, {1, 0, 0}};
-    m.indices = {0, 1, 2};
-    compute_normals(m);
-    BakeOptions o;
-    o.normalize = true;
-    for (const char* spec : {"lebedev:74", "mc:50", "fibonacci:33+rotate"}) {
-        BakeOutputs out;
-        make_visibility_backend("embree")->bake(m, parse_rule(spec), o, out);
-        for (std::size_t v = 0; v < 3; ++v) {
-            EXPECT_FLOAT_EQ(out.ao[v], 1.0f) << spec;
-            EXPECT_FLOAT_EQ(out.shading[v], 1.0f) << spec;
-        }
-    }
-}
-
 TEST(Visibility, BackFacesOccludeOrNot) {
     // A ceiling at y = 1 whose front side faces down (towards the floor point),
     // and the same ceiling flipped.
@@ -224,7 +129,7 @@ TEST(Visibility, BackFacesOccludeOrNot) {
             std::swap(m.indices[1], m.indices[2]);
         const Ray up{{0, 0, 0}, 0.0f, {0, 1, 0}, 100.0f};
         for (const char* name : {"embree", "brute"}) {
-            auto b = make_visibility_backend(name);
+            auto b = make_ray_queries(name);
             std::uint8_t occ = 0;
             b->set_mesh(m, BackFaces::Occlude);
             b->occluded({&up, 1}, {&occ, 1});
@@ -242,145 +147,135 @@ TEST(Visibility, BackFacesOccludeOrNot) {
     EXPECT_THROW(parse_back_faces("cull"), Error);
 }
 
-TEST(Visibility, MaxDistanceIgnoresFarOccluders) {
-    // Floor triangle at y = 0 under a huge ceiling at y = 2. Ceiling front faces down.
-    Mesh m = one_triangle_facing_down(2.0f);
-    const auto base = std::uint32_t(m.positions.size());
-    m.positions.insert(m.positions.end(), {{0, 0, 0}, {0, 0, 0.1f}, {0.1f, 0, 0}});
-    m.indices.insert(m.indices.end(), {base, base + 1, base + 2});
-    compute_normals(m);
-    const SphereRule rule = parse_rule("lebedev:5810");
-    // The rule applied to the exact visibility for D = 4 (blocked: cos θ > 1/2).
-    double rule_exact = 0.0;
-    for (std::size_t k = 0; k < rule.size(); ++k)
-        if (rule.points[k].y > 0.0 && rule.points[k].y <= 0.5)
-            rule_exact += 4.0 * rule.weights[k] * rule.points[k].y;
-    for (const char* name : {"embree", "brute"}) {
-        BakeOptions o;
-        o.ray_offset = 1e-4f;
-        BakeOutputs near_only, far;
-        o.max_distance = 1.5f; // shorter than the gap: nothing blocks
-        make_visibility_backend(name)->bake(m, rule, o, near_only);
-        o.max_distance = std::numeric_limits<float>::infinity();
-        make_visibility_backend(name)->bake(m, rule, o, far);
-        // Closed form: under a ceiling at height h, with max distance D > h, the
-        // directions within θ < acos(h/D) of the normal are blocked (while the
-        // hit stays inside the ceiling triangle); that cone holds a share
-        // sin²θ = 1 − (h/D)² of the cosine-weighted hemisphere, so AO = (h/D)².
-        // Here D < h: AO ≈ 1 (the rule's own error only).
-        EXPECT_NEAR(near_only.ao[base], 1.0f, 2e-4f) << name;
-        // Unlimited: the ceiling triangle (20 × 20 at height 2) blocks most of the sky.
-        EXPECT_LT(far.ao[base], 0.2f) << name;
-        // D = 4: AO = (2/4)² = 0.25 (the cone's rim, 3.5 from the axis, stays
-        // inside the triangle, whose nearest edge is 4.47 away). The bake equals
-        // the rule applied to the exact visibility up to a direction or two on
-        // the rim (4 w_k each); that differs from the closed form by the rule's
-        // quadrature error for a cone, a few 1e-3 at 5810 points.
-        o.max_distance = 4.0f;
-        BakeOutputs mid;
-        make_visibility_backend(name)->bake(m, rule, o, mid);
-        EXPECT_NEAR(mid.ao[base], rule_exact, 2.0 * 4.0 / 5810.0) << name;
-        EXPECT_NEAR(mid.ao[base], 0.25f, 5e-3f) << name;
+
+namespace {
+
+// Every vertex's words from `tracer` for `rule`, in chunks of `chunk`
+// vertices, with ray origins a little above each vertex along its normal.
+std::vector<std::uint32_t> trace_words(VisibilityTracer& tracer, const Mesh& m, const SphereRule& rule, bool rotate,
+                                       std::uint32_t chunk, float t_max) {
+    const auto points = rule.points_f32();
+    std::vector<std::uint32_t> order(points.size());
+    for (std::uint32_t k = 0; k < order.size(); ++k)
+        order[k] = std::uint32_t(order.size()) - 1 - k; // any permutation will do
+    std::vector<glm::vec3> visit(points.size());
+    for (std::size_t j = 0; j < order.size(); ++j)
+        visit[j] = points[order[j]];
+    TraceRule r;
+    r.points = visit;
+    r.order = order;
+    r.words_per_vertex = visibility_words(std::uint32_t(points.size()));
+    r.rotate = rotate;
+    r.t_max = t_max;
+    tracer.set_mesh(m);
+    chunk = std::min(chunk, tracer.set_rule(r));
+    const auto n = std::uint32_t(m.vertex_count());
+    std::vector<glm::vec3> origins(n), normals(n);
+    std::vector<glm::mat3> rotations(rotate ? n : 0);
+    for (std::uint32_t v = 0; v < n; ++v) {
+        normals[v] = glm::normalize(m.normals[v]);
+        origins[v] = m.positions[v] + 1e-3f * normals[v];
+        if (rotate) // a quarter turn about z, vertex by vertex alternately
+            rotations[v] = (v % 2) ? glm::mat3(0, 1, 0, -1, 0, 0, 0, 0, 1) : glm::mat3(1.0f);
     }
+    std::vector<std::uint32_t> words(std::size_t(n) * r.words_per_vertex, 0xdeadbeefu);
+    for (std::uint32_t first = 0; first < n; first += chunk) {
+        TraceChunk c;
+        c.first = first;
+        c.count = std::min(chunk, n - first);
+        c.origins = std::span(origins).subspan(first, c.count);
+        c.normals = std::span(normals).subspan(first, c.count);
+        if (rotate)
+            c.rotations = std::span(rotations).subspan(first, c.count);
+        c.words = std::span(words).subspan(std::size_t(first) * r.words_per_vertex,
+                                           std::size_t(c.count) * r.words_per_vertex);
+        tracer.trace(c);
+    }
+    return words;
 }
 
-TEST(Visibility, ResultsDoNotDependOnThreadCount) {
-    const Mesh m = random_mesh(21, 300);
-    for (const char* spec : {"lebedev:230+rotate=9", "lebedev:1202"}) {
-        const SphereRule rule = parse_rule(spec);
-        BakeOptions o;
-        o.store_bits = true;
-        BakeOutputs one, all;
-        set_thread_count(1);
-        make_visibility_backend("embree")->bake(m, rule, o, one);
-        set_thread_count(0);
-        make_visibility_backend("embree")->bake(m, rule, o, all);
-        EXPECT_EQ(one.ao, all.ao) << spec;
-        EXPECT_EQ(one.shading, all.shading);
-        EXPECT_EQ(one.bent_normal, all.bent_normal);
-        EXPECT_EQ(one.visibility_bits, all.visibility_bits);
-        EXPECT_EQ(one.rays, all.rays);
-    }
-}
+} // namespace
 
-TEST(Visibility, ReductionFromBitsEqualsTheBake) {
-    // The HD reduction from stored bits (what a CUDA kernel would run) gives the
-    // bake's results bit for bit: same arithmetic, same order.
-    const Mesh m = random_mesh(31, 150);
-    for (const char* spec : {"lebedev:266", "design:t9+rotate=4", "lebedev:1202+rotate"}) {
-        const SphereRule rule = parse_rule(spec);
-        for (bool normalize : {false, true}) {
-            BakeOptions o;
-            o.store_bits = true;
-            o.normalize = normalize;
-            BakeOutputs out;
-            make_visibility_backend("embree")->bake(m, rule, o, out);
-            BakeOutputs scratch;
-            const visibility::BakeSetup s = visibility::prepare_bake(m, rule, o, scratch);
+TEST(Visibility, TracersFillTheDocumentedWords) {
+    // The tracer contract on its own, without the bake driver: every tracer
+    // gives the brute-force oracle's words up to edge ties, whatever the
+    // chunking; bits below the horizon and past the rule are 0; a set bit
+    // means the ray really leaves the mesh.
+    const Mesh m = random_mesh(11, 60);
+    const SphereRule rule = parse_rule("lebedev:110");
+    const auto points = rule.points_f32();
+    for (bool rotate : {false, true})
+        for (float t_max : {std::numeric_limits<float>::infinity(), 0.7f}) {
+            auto brute = make_visibility_tracer("brute");
+            const auto ref = trace_words(*brute, m, rule, rotate, 1u << 20, t_max);
+            auto queries = make_ray_queries("brute");
+            queries->set_mesh(m);
+            const std::uint32_t W = visibility_words(std::uint32_t(points.size()));
             for (std::uint32_t v = 0; v < m.vertex_count(); ++v) {
-                const auto f = visibility::vertex_frame(s, m, v);
-                const auto r = visibility::shading_from_bits(&out.visibility_bits[v * out.words_per_vertex],
-                                                             s.points.data(), s.weights.data(), s.order.data(),
-                                                             s.directions, f.normal, f.rotation, s.rotate, normalize);
-                ASSERT_EQ(r.ao, out.ao[v]) << spec << " vertex " << v;
-                ASSERT_EQ(r.shading, out.shading[v]);
-                ASSERT_EQ(r.bent_normal, out.bent_normal[v]);
+                const glm::vec3 n = glm::normalize(m.normals[v]);
+                for (std::uint32_t k = 0; k < W * 32; ++k) {
+                    const bool bit = (ref[v * W + k / 32] >> (k % 32)) & 1u;
+                    if (k >= points.size()) {
+                        ASSERT_FALSE(bit) << "bit past the rule";
+                        continue;
+                    }
+                    glm::vec3 x = points[k];
+                    if (rotate && v % 2)
+                        x = glm::vec3(-x.y, x.x, x.z);
+                    if (glm::dot(n, x) < 0.0f) {
+                        ASSERT_FALSE(bit) << "bit below the horizon";
+                        continue;
+                    }
+                    const Ray ray{m.positions[v] + 1e-3f * n, 0.0f, x, t_max};
+                    std::uint8_t occ = 0;
+                    queries->occluded({&ray, 1}, {&occ, 1});
+                    ASSERT_EQ(bit, occ == 0) << "vertex " << v << " direction " << k;
+                }
+            }
+            auto embree = make_visibility_tracer("embree");
+            visibility::EmulatedCudaTracer emulated;
+            for (std::uint32_t chunk : {1u, 7u, 1u << 20}) {
+                for (VisibilityTracer* t : {static_cast<VisibilityTracer*>(embree.get()),
+                                            static_cast<VisibilityTracer*>(&emulated)}) {
+                    const auto got = trace_words(*t, m, rule, rotate, chunk, t_max);
+                    std::size_t diff = 0;
+                    for (std::size_t i = 0; i < got.size(); ++i)
+                        diff += std::size_t(__builtin_popcount(got[i] ^ ref[i]));
+                    // Single-precision traversals against the double-precision
+                    // oracle: a ray or two grazing an edge may differ.
+                    EXPECT_LE(diff, 2u) << t->name() << " chunk " << chunk << " rotate " << rotate;
+                }
             }
         }
-    }
 }
 
-TEST(Visibility, CoherentOrderIsAPermutation) {
-    const SphereRule rule = parse_rule("lebedev:5810");
-    const auto pts = rule.points_f32();
-    auto order = visibility::coherent_direction_order(pts);
-    // Consecutive directions are close: the mean angle step is a few rule spacings.
-    double step = 0;
-    for (std::size_t j = 1; j < order.size(); ++j)
-        step += std::acos(std::clamp(double(glm::dot(pts[order[j - 1]], pts[order[j]])), -1.0, 1.0));
-    step /= double(order.size() - 1);
-    EXPECT_LT(step, 3.0 * std::sqrt(4.0 * 3.14159265 / double(pts.size())));
-    std::sort(order.begin(), order.end());
-    for (std::size_t k = 0; k < order.size(); ++k)
-        ASSERT_EQ(order[k], k);
-}
-
-TEST(Visibility, Errors) {
+TEST(Visibility, FactoriesRefuseWhatTheyCannotMake) {
     if (cuda_device_count() == 0) { // without a GPU (or CUDA) "cuda" is a clear error
-        EXPECT_THROW(make_visibility_backend("cuda"), Error);
+        EXPECT_THROW(make_visibility_tracer("cuda"), Error);
+        EXPECT_THROW(make_ray_queries("cuda"), Error);
     }
-    EXPECT_THROW(make_visibility_backend("optix"), Error);
+    try {
+        make_visibility_tracer("optix");
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.where(), "backend");
+        EXPECT_NE(e.message().find("embree"), std::string::npos) << e.message();
+    }
+    try {
+        make_visibility_tracer("embree", TraceMethod::PerVertex);
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.where(), "method");
+    }
     const Mesh big = generate_mesh({ProceduralKind::Sphere, 40000, 1});
-    EXPECT_THROW(make_visibility_backend("brute")->set_mesh(big), Error);
-
-    Mesh m = random_mesh(1, 10);
-    const SphereRule rule = parse_rule("lebedev:50");
-    BakeOutputs out;
-    auto b = make_visibility_backend("embree");
-    BakeOptions o;
-    o.max_distance = 0.0f;
-    EXPECT_THROW(b->bake(m, rule, o, out), Error);
-    o.max_distance = std::nanf("");
-    EXPECT_THROW(b->bake(m, rule, o, out), Error);
-    o = {};
-    o.ray_offset = std::numeric_limits<float>::infinity();
-    EXPECT_THROW(b->bake(m, rule, o, out), Error);
-    EXPECT_THROW(b->bake(m, parse_rule("phong:a=8,n=4"), BakeOptions{}, out), Error);
-    Mesh no_normals = m;
-    no_normals.normals.clear();
-    EXPECT_THROW(b->bake(no_normals, rule, BakeOptions{}, out), Error);
-    Mesh bad = m;
-    bad.indices.push_back(100000);
-    bad.indices.push_back(0);
-    bad.indices.push_back(1);
-    EXPECT_THROW(b->bake(bad, rule, BakeOptions{}, out), Error);
-}
-
-TEST(Visibility, DefaultOffsetScalesWithTheMesh) {
-    Mesh m = random_mesh(2, 10);
-    const float d = compute_bounds(m).diagonal();
-    EXPECT_FLOAT_EQ(resolve_ray_offset(m, {}), kDefaultRayOffsetScale * d);
-    BakeOptions o;
-    o.ray_offset = 0.5f;
-    EXPECT_FLOAT_EQ(resolve_ray_offset(m, o), 0.5f);
+    EXPECT_THROW(make_ray_queries("brute")->set_mesh(big), Error);
+    for (TraceMethod mth : {TraceMethod::Bvh, TraceMethod::PerVertex, TraceMethod::PerPolygon})
+        EXPECT_EQ(parse_trace_method(trace_method_name(mth)), mth);
+    try {
+        parse_trace_method("octree");
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.message(), "unknown method 'octree'; choose bvh (default), per-vertex (every triangle for every "
+                               "ray) or per-polygon (every triangle, cached in shared memory; cuda backend)");
+    }
 }

@@ -1,8 +1,8 @@
 // The CUDA backend's host-side code on the CPU: the BVH built with Embree's
 // builder and flattened (structure invariants), its traversal (the same
 // SKYBAKE_HD function the kernels run) against the plain loop over every
-// triangle and against Embree, and the kernels' thread bodies run on the host
-// (emulate_bake) against the Embree backend's bake.
+// triangle and against Embree. The bakes through the kernels' thread bodies are
+// in src/bake/cuda_bake_test.cpp.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,7 +16,6 @@
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 #include "skybake/visibility.h"
-#include "visibility/cuda/bake_plan.h"
 #include "visibility/cuda/bvh.h"
 #include "visibility/cuda/cuda_backend.h"
 #include "visibility/cuda/test_scenes.h"
@@ -176,7 +175,7 @@ TEST(CudaBvh, TraversalEqualsTheLoopOverEveryTriangle) {
 // The counting traversal (benchmarks) answers as the plain one, and a ray that
 // misses the root's boxes visits the root only.
 TEST(CudaBvh, CountedTraversalAnswersTheSame) {
-    const Mesh m = ao_test::generated(ProceduralKind::Torus, 2000);
+    const Mesh m = generated(ProceduralKind::Torus, 2000);
     const Bvh bvh = build_bvh(m);
     std::uint64_t nodes = 0;
     for (const Ray& r : rays_for(m, 4, 2000, false)) {
@@ -286,87 +285,3 @@ TEST(CudaBvh, TraversalAgreesWithEmbree) {
     }
 }
 
-// The kernels' thread bodies, run on the host, against the Embree bake
-// (expect_agreement: bits, AO, and the same floats wherever the bits agree).
-TEST(CudaBake, EmulatedKernelsMatchEmbree) {
-    struct Case {
-        const char* rule;
-        BackFaces back;
-        float max_distance;
-        bool normalize;
-    };
-    const Case cases[] = {{"lebedev:590", BackFaces::Occlude, INFINITY, false},
-                          {"lebedev:302+rotate", BackFaces::Occlude, INFINITY, true},
-                          {"fibonacci:500", BackFaces::Ignore, INFINITY, false},
-                          {"lebedev:266", BackFaces::Occlude, 0.2f, false}};
-    for (const auto& [name, m] : scenes()) {
-        for (const Case& c : cases) {
-            SCOPED_TRACE(name + " " + c.rule);
-            const SphereRule rule = parse_rule(c.rule);
-            BakeOptions o;
-            o.store_bits = true;
-            o.back_faces = c.back;
-            o.normalize = c.normalize;
-            o.max_distance = std::isfinite(c.max_distance) ? c.max_distance * compute_bounds(m).diagonal() : INFINITY;
-            BakeOutputs e;
-            EmbreeBackend embree;
-            embree.bake(m, rule, o, e);
-            const BakeOutputs g = emulated(m, rule, o, TraceMethod::Bvh);
-            const Agreement a = compare_bakes(m, rule, o, g, e);
-            a.print((name + " " + c.rule + ", host emulation").c_str());
-            expect_agreement(a, tie_free(name, rule));
-        }
-    }
-}
-
-TEST(CudaBake, EveryMethodAndChunkingGiveTheSameBits) {
-    const Mesh m = ao_test::generated(ProceduralKind::City, 1500);
-    const SphereRule rule = parse_rule("lebedev:194+rotate");
-    BakeOptions o;
-    o.store_bits = true;
-    const BakeOutputs a = emulated(m, rule, o, TraceMethod::Bvh);
-    const BakeOutputs b = emulated(m, rule, o, TraceMethod::PerVertex);
-    const BakeOutputs c = emulated(m, rule, o, TraceMethod::Bvh, 7); // many small chunks
-    for (const BakeOutputs* x : {&b, &c}) {
-        EXPECT_EQ(x->visibility_bits, a.visibility_bits);
-        EXPECT_EQ(x->ao, a.ao);
-        EXPECT_EQ(x->shading, a.shading);
-        EXPECT_EQ(x->bent_normal, a.bent_normal);
-        EXPECT_EQ(x->rays, a.rays);
-    }
-}
-
-TEST(CudaBake, MethodNamesAndTheCpuBackendsRefuseOthers) {
-    for (TraceMethod mth : {TraceMethod::Bvh, TraceMethod::PerVertex, TraceMethod::PerPolygon})
-        EXPECT_EQ(parse_trace_method(trace_method_name(mth)), mth);
-    EXPECT_THROW(parse_trace_method("octree"), Error);
-    const auto names = visibility_backend_names();
-    EXPECT_EQ(std::count(names.begin(), names.end(), "cuda"), build_has_cuda() ? 1 : 0);
-    EXPECT_EQ(std::count(names.begin(), names.end(), "embree"), 1);
-    Mesh m = ao_test::generated(ProceduralKind::Sphere, 200);
-    BakeOptions o;
-    o.method = TraceMethod::PerPolygon;
-    BakeOutputs out;
-    for (const char* b : {"embree", "brute"}) {
-        auto backend = make_visibility_backend(b);
-        try {
-            backend->bake(m, parse_rule("lebedev:50"), o, out);
-            ADD_FAILURE() << b << " accepted per-polygon";
-        } catch (const Error& e) {
-            EXPECT_NE(std::string(e.what()).find("cuda"), std::string::npos) << e.what();
-        }
-    }
-}
-
-TEST(CudaBake, WithoutADeviceTheBackendIsAClearError) {
-    if (cuda_device_count() > 0)
-        GTEST_SKIP() << "a CUDA device is present";
-    try {
-        make_visibility_backend("cuda");
-        ADD_FAILURE() << "no error";
-    } catch (const Error& e) {
-        const std::string what = e.what();
-        EXPECT_NE(what.find("--device cpu"), std::string::npos) << what; // says what to use instead
-        EXPECT_EQ(what.find('\n'), std::string::npos) << what;
-    }
-}

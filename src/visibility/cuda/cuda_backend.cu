@@ -1,10 +1,10 @@
-// The CUDA visibility backend: kernels and their host driver.
+// The CUDA visibility backend: kernels and their host side.
 //
 // Svistunov, GPU computation of shading coefficients for interactive lighting
 // (seed 002): vertices × directions in parallel, visibility as bits with an
 // early exit per ray, launches cut into chunks, polygons cached in shared
 // memory for the tiled brute-force method. The thread bodies are the SKYBAKE_HD
-// functions of bake_hd.h and bvh.h, which the CPU tests run too.
+// functions of tracer_hd.h and bvh.h, which the CPU tests run too.
 //
 // Aila T., Laine S. Understanding the efficiency of ray traversal on GPUs.
 // HPG 2009 (one ray per thread, a short stack, 16-byte node loads through the
@@ -12,20 +12,19 @@
 //
 // This file is compiled with --fmad=false (src/CMakeLists.txt): without
 // contracted multiply-adds the kernels round exactly as the host does, so the
-// GPU gives the same bits and AO values as emulate_bake() on the CPU.
+// GPU gives the same bits as EmulatedCudaTracer on the CPU.
 #include <algorithm>
-#include <chrono>
 #include <cstring>
 #include <string>
 #include <type_traits>
 
 #include "core/cuda_util.h"
-#include "core/progress.h"
 #include "skybake/core.h"
 #include "skybake/error.h"
 #include "skybake/mesh.h"
-#include "visibility/cuda/bake_plan.h"
 #include "visibility/cuda/cuda_backend.h"
+#include "visibility/cuda/emulated_tracer.h"
+#include "visibility/cuda/tracer_hd.h"
 
 namespace skybake::visibility {
 
@@ -40,13 +39,13 @@ constexpr std::size_t kRaysPerQuery = std::size_t(1) << 22;
 // One warp per (chunk vertex, visibility word): lane l traces visiting position
 // 32·word + l, and the warp's answers become the word.
 template <TraceMethod M>
-__global__ void __launch_bounds__(kBlock) trace_kernel(GpuBakeParams p) {
+__global__ void __launch_bounds__(kBlock) trace_kernel(GpuTraceParams p) {
     const std::uint64_t warp = (std::uint64_t(blockIdx.x) * blockDim.x + threadIdx.x) >> 5;
     const unsigned lane = threadIdx.x & 31u;
     if (warp >= std::uint64_t(p.vertex_count) * p.words)
         return; // the whole warp leaves together
     const auto v = std::uint32_t(warp / p.words), w = std::uint32_t(warp % p.words);
-    const bool visible = bake_visible<M>(p, v, 32u * w + lane);
+    const bool visible = trace_visible<M>(p, v, 32u * w + lane);
     const unsigned bits = __ballot_sync(0xffffffffu, visible);
     if (lane == 0)
         p.visit_words[warp] = bits;
@@ -55,7 +54,7 @@ __global__ void __launch_bounds__(kBlock) trace_kernel(GpuBakeParams p) {
 // The seed's polygon caching: the block walks the triangle soup in tiles of
 // kTile triangles staged in shared memory, every thread testing its ray
 // against the tile; it stops as soon as every ray of the block is blocked.
-__global__ void __launch_bounds__(kBlock) trace_tiled_kernel(GpuBakeParams p) {
+__global__ void __launch_bounds__(kBlock) trace_tiled_kernel(GpuTraceParams p) {
     __shared__ float4 tile[3 * kTile];
     const std::uint64_t warp = (std::uint64_t(blockIdx.x) * blockDim.x + threadIdx.x) >> 5;
     const unsigned lane = threadIdx.x & 31u;
@@ -64,7 +63,7 @@ __global__ void __launch_bounds__(kBlock) trace_tiled_kernel(GpuBakeParams p) {
     bool need = false;
     if (active) {
         const auto v = std::uint32_t(warp / p.words), w = std::uint32_t(warp % p.words);
-        need = bake_ray(p, v, 32u * w + lane, o, d);
+        need = trace_ray(p, v, 32u * w + lane, o, d);
     }
     bool blocked = false;
     const auto* soup = reinterpret_cast<const float4*>(p.soup);
@@ -97,35 +96,13 @@ __global__ void __launch_bounds__(kBlock) trace_tiled_kernel(GpuBakeParams p) {
         p.visit_words[warp] = bits;
 }
 
-// kReduceLanes threads per vertex, one per partial sum; the group's first
-// thread gathers the partials in lane order and stores the vertex.
-__global__ void __launch_bounds__(kBlock) reduce_kernel(GpuBakeParams p) {
-    static_assert(32 % kReduceLanes == 0);
-    const std::uint32_t t = blockIdx.x * blockDim.x + threadIdx.x;
-    const std::uint32_t v = t / kReduceLanes, l = t % kReduceLanes;
-    const bool active = v < p.vertex_count;
-    ShadingPartials s;
-    std::uint32_t traced = 0;
-    if (active)
-        traced = bake_reduce_lane(p, v, l, s);
-    // Every lane of the warp takes part in the shuffles.
-    const unsigned first = (threadIdx.x & 31u) & ~(kReduceLanes - 1u);
-    ShadingPartials all;
-    std::uint32_t total = 0;
-#pragma unroll
-    for (std::uint32_t k = 0; k < kReduceLanes; ++k) {
-        const unsigned src = first + k;
-        all.ao[k] = __shfl_sync(0xffffffffu, s.ao[0], src);
-        all.ao_open[k] = __shfl_sync(0xffffffffu, s.ao_open[0], src);
-        all.a[k] = __shfl_sync(0xffffffffu, s.a[0], src);
-        all.a_open[k] = __shfl_sync(0xffffffffu, s.a_open[0], src);
-        all.bx[k] = __shfl_sync(0xffffffffu, s.bx[0], src);
-        all.by[k] = __shfl_sync(0xffffffffu, s.by[0], src);
-        all.bz[k] = __shfl_sync(0xffffffffu, s.bz[0], src);
-        total += __shfl_sync(0xffffffffu, traced, src);
-    }
-    if (active && l == 0)
-        bake_store(p, v, all, total);
+// One thread per rule-order output word: the bits of its 32 rule directions,
+// gathered from the visiting-order words.
+__global__ void __launch_bounds__(kBlock) gather_kernel(GpuTraceParams p) {
+    const std::uint64_t t = std::uint64_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (t >= std::uint64_t(p.vertex_count) * p.words)
+        return;
+    p.rule_words[t] = gather_word(p, std::uint32_t(t / p.words), std::uint32_t(t % p.words));
 }
 
 // One ray per thread: occlusion (Out = std::uint8_t) or the closest hit (Out = RayHit).
@@ -155,9 +132,9 @@ __global__ void query_kernel(BvhView bvh, const Ray* rays, Out* out, std::uint32
 template <class Out>
 void run_queries(const BvhView& bvh, bool cull_back, std::span<const Ray> rays, std::span<Out> out, const char* what) {
     if (rays.size() != out.size())
-        throw Error(std::string(what) + "(): the output size differs from the ray count", "cuda");
+        throw Error(std::string(what) + "(): the output size differs from the ray count", "rays");
     if (bvh.node_count == 0)
-        throw Error(std::string(what) + "(): no mesh; call set_mesh() first", "cuda");
+        throw Error(std::string(what) + "(): no mesh; call set_mesh() first", "mesh");
     cuda::DeviceBuffer<Ray> d_rays(std::min(rays.size(), kRaysPerQuery));
     cuda::DeviceBuffer<Out> d_out(std::min(rays.size(), kRaysPerQuery));
     for (std::size_t first = 0; first < rays.size(); first += kRaysPerQuery) {
@@ -169,88 +146,10 @@ void run_queries(const BvhView& bvh, bool cull_back, std::span<const Ray> rays, 
     }
 }
 
-// [SECTION] Host memory and streams ------------------------------------------------------------
-
-// Page-locked host array, so that copies can run asynchronously.
-template <class T>
-class PinnedBuffer {
-public:
-    PinnedBuffer() = default;
-    ~PinnedBuffer() {
-        if (ptr_)
-            cudaFreeHost(ptr_);
-    }
-    PinnedBuffer(const PinnedBuffer&) = delete;
-    PinnedBuffer& operator=(const PinnedBuffer&) = delete;
-    void resize(std::size_t n) {
-        if (n <= size_)
-            return;
-        if (ptr_)
-            cudaFreeHost(ptr_);
-        ptr_ = nullptr;
-        size_ = 0;
-        SKYBAKE_CUDA_CHECK(cudaMallocHost(reinterpret_cast<void**>(&ptr_), n * sizeof(T)));
-        size_ = n;
-    }
-    T* data() { return ptr_; }
-
-private:
-    T* ptr_ = nullptr;
-    std::size_t size_ = 0;
-};
-
-class Stream {
-public:
-    Stream() { SKYBAKE_CUDA_CHECK(cudaStreamCreateWithFlags(&s_, cudaStreamNonBlocking)); }
-    ~Stream() {
-        if (s_)
-            cudaStreamDestroy(s_);
-    }
-    Stream(const Stream&) = delete;
-    Stream& operator=(const Stream&) = delete;
-    operator cudaStream_t() const { return s_; }
-
-private:
-    cudaStream_t s_ = nullptr;
-};
-
-// One in-flight chunk: device buffers, pinned staging, and which vertices it holds.
-struct ChunkSlot {
-    Stream stream;
-    cuda::DeviceBuffer<glm::vec3> origins, normals, bent;
-    cuda::DeviceBuffer<glm::mat3> rotations;
-    cuda::DeviceBuffer<std::uint32_t> visit_words, rule_words, rays, clamped;
-    cuda::DeviceBuffer<float> ao, shading;
-    PinnedBuffer<glm::vec3> h_origins, h_normals, h_bent;
-    PinnedBuffer<glm::mat3> h_rotations;
-    PinnedBuffer<std::uint32_t> h_rule_words, h_rays, h_clamped;
-    PinnedBuffer<float> h_ao, h_shading;
-    bool busy = false;
-    std::uint32_t first = 0, count = 0;
-
-    void allocate(std::uint32_t n, std::uint32_t words, bool rotate, bool store_bits) {
-        origins.resize(n), normals.resize(n), bent.resize(n);
-        rotations.resize(rotate ? n : 0);
-        visit_words.resize(std::size_t(n) * words);
-        rule_words.resize(store_bits ? std::size_t(n) * words : 0);
-        rays.resize(n), clamped.resize(n), ao.resize(n), shading.resize(n);
-        h_origins.resize(n), h_normals.resize(n), h_bent.resize(n);
-        if (rotate)
-            h_rotations.resize(n);
-        if (store_bits)
-            h_rule_words.resize(std::size_t(n) * words);
-        h_rays.resize(n), h_clamped.resize(n), h_ao.resize(n), h_shading.resize(n);
-    }
-};
-
-// Device bytes one chunk vertex needs.
-std::uint64_t bytes_per_vertex(std::uint32_t words, bool rotate, bool store_bits) {
-    std::uint64_t b = 3 * sizeof(glm::vec3) + 2 * sizeof(float) + 2 * sizeof(std::uint32_t) + 4ull * words;
-    if (rotate)
-        b += sizeof(glm::mat3);
-    if (store_bits)
-        b += 4ull * words;
-    return b;
+// Device bytes one chunk vertex needs: origin, normal, rotation, and the
+// visiting-order and rule-order words.
+std::uint64_t bytes_per_vertex(std::uint32_t words, bool rotate) {
+    return 2 * sizeof(glm::vec3) + (rotate ? sizeof(glm::mat3) : 0) + 8ull * words;
 }
 
 std::string mib(std::uint64_t bytes) {
@@ -268,14 +167,22 @@ struct CudaBackend::Impl {
     bool cull_back = false;
     cuda::DeviceBuffer<BvhNode> nodes;
     cuda::DeviceBuffer<BvhTriangle> triangles, soup;
+    TraceMethod method = TraceMethod::Bvh;
     std::uint32_t chunks = 0;
+    // The rule of the current bake, and one chunk's buffers.
+    TraceRule rule;
+    cuda::DeviceBuffer<glm::vec3> points, origins, normals;
+    cuda::DeviceBuffer<std::uint32_t> position, visit_words, rule_words;
+    cuda::DeviceBuffer<glm::mat3> rotations;
+    std::uint32_t chunk_limit = 0;
 
     // What the backend may allocate beyond what it holds now.
     std::uint64_t budget() const {
         std::size_t free_bytes = 0, total = 0;
         SKYBAKE_CUDA_CHECK(cudaMemGetInfo(&free_bytes, &total));
-        const std::uint64_t held =
-            nodes.size() * sizeof(BvhNode) + (triangles.size() + soup.size()) * sizeof(BvhTriangle);
+        const std::uint64_t held = nodes.size() * sizeof(BvhNode) +
+                                   (triangles.size() + soup.size()) * sizeof(BvhTriangle) +
+                                   points.size() * sizeof(glm::vec3) + position.size() * sizeof(std::uint32_t);
         if (limits.memory_bytes > 0)
             return limits.memory_bytes > held ? limits.memory_bytes - held : 0;
         return std::uint64_t(double(free_bytes) * 0.9);
@@ -286,10 +193,10 @@ struct CudaBackend::Impl {
     }
 };
 
-CudaBackend::CudaBackend() : impl_(std::make_unique<Impl>()) {
+CudaBackend::CudaBackend(TraceMethod method) : impl_(std::make_unique<Impl>()) {
+    impl_->method = method;
     if (cuda_device_count() == 0)
-        throw Error("no usable CUDA device (" + cuda_device_problem() + "); bake on the CPU (--device cpu)",
-                    "--device cuda");
+        throw Error("no usable CUDA device (" + cuda_device_problem() + "); bake on the CPU instead", "device");
     SKYBAKE_CUDA_CHECK(cudaSetDevice(0));
     impl_->device = cuda_device_name();
 }
@@ -305,8 +212,14 @@ const CudaBackend::Limits& CudaBackend::limits() const {
 std::string CudaBackend::device_name() const {
     return impl_->device;
 }
+TraceMethod CudaBackend::method() const {
+    return impl_->method;
+}
 std::uint32_t CudaBackend::last_chunk_count() const {
     return impl_->chunks;
+}
+const std::uint32_t* CudaBackend::device_words() const {
+    return impl_->rule_words.data();
 }
 const Bvh& CudaBackend::bvh() const {
     return impl_->bvh;
@@ -316,14 +229,15 @@ void CudaBackend::set_mesh(const Mesh& mesh, BackFaces back_faces) {
     Impl& m = *impl_;
     // Release the previous mesh first: its memory counts as free again.
     m.nodes.resize(0), m.triangles.resize(0), m.soup.resize(0);
+    m.origins.resize(0), m.normals.resize(0), m.rotations.resize(0), m.visit_words.resize(0), m.rule_words.resize(0);
     m.bvh = build_bvh(mesh);
     m.cull_back = back_faces == BackFaces::Ignore;
     const std::uint64_t need = m.bvh.bytes(), have = m.budget();
     if (need > have)
         throw Error("the mesh's BVH (" + std::to_string(mesh.triangle_count()) + " triangles) needs " + mib(need) +
                         " of GPU memory, but only " + mib(have) + " is available on " + m.device +
-                        "; use --device cpu, or a GPU with more memory",
-                    "--backend cuda");
+                        "; bake on the CPU, or on a GPU with more memory",
+                    "device");
     m.nodes.upload(m.bvh.nodes.data(), m.bvh.nodes.size());
     m.triangles.upload(m.bvh.triangles.data(), m.bvh.triangles.size());
     m.soup.upload(m.bvh.soup.data(), m.bvh.soup.size());
@@ -338,140 +252,88 @@ void CudaBackend::intersect(std::span<const Ray> rays, std::span<RayHit> hits) c
     run_queries(impl_->device_view(), impl_->cull_back, rays, hits, "intersect");
 }
 
-void CudaBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options, BakeOutputs& out) {
+std::uint32_t CudaBackend::set_rule(const TraceRule& rule) {
     Impl& m = *impl_;
-    const BakePlan plan = plan_bake(mesh, rule, options, out);
-    const auto t0 = std::chrono::steady_clock::now();
-    set_mesh(mesh, options.back_faces);
-    const auto t1 = std::chrono::steady_clock::now();
-    out.build_seconds = std::chrono::duration<double>(t1 - t0).count();
+    m.rule = rule;
+    m.chunks = 0;
+    const auto directions = std::uint32_t(rule.points.size());
+    const std::uint32_t words = rule.words_per_vertex;
+    const std::vector<std::uint32_t> position = visiting_positions(rule.order);
+    m.points.upload(rule.points.data(), directions);
+    m.position.upload(position.data(), directions);
 
-    const BakeSetup& s = plan.setup;
-    const auto n = std::uint32_t(mesh.vertex_count());
-    const std::uint32_t words = s.words;
-
-    // The rule in visiting order, once for every chunk.
-    cuda::DeviceBuffer<glm::vec3> d_points;
-    cuda::DeviceBuffer<float> d_weights;
-    cuda::DeviceBuffer<std::uint32_t> d_order;
-    d_points.upload(s.sorted_points.data(), s.directions);
-    d_weights.upload(s.sorted_weights.data(), s.directions);
-    d_order.upload(s.order.data(), s.directions);
-    // Those copies ran on the legacy stream, which the chunk streams do not wait for.
-    SKYBAKE_CUDA_CHECK(cudaStreamSynchronize(nullptr));
-
-    // Chunk size: bounded work per launch and memory for two chunks in flight.
+    // Chunk size: bounded work per launch, and memory for one chunk.
     const std::uint64_t slots = 32ull * words;
-    const std::uint64_t work = options.method == TraceMethod::Bvh
+    const std::uint64_t work = m.method == TraceMethod::Bvh
                                    ? m.limits.slots_per_launch / slots
                                    : m.limits.tests_per_launch / (slots * std::max<std::uint64_t>(1, m.soup.size()));
-    const std::uint64_t rule_bytes = std::uint64_t(s.directions) * (sizeof(glm::vec3) + sizeof(float) + 4);
     const std::uint64_t budget = m.budget();
-    const std::uint64_t per_vertex = bytes_per_vertex(words, s.rotate, s.store_bits);
-    const std::uint64_t fit = budget > rule_bytes ? (budget - rule_bytes) / (2 * per_vertex) : 0;
+    const std::uint64_t fit = budget / bytes_per_vertex(words, rule.rotate);
     if (fit == 0)
         throw Error("not enough GPU memory on " + m.device + " for even one vertex of the bake (" + mib(budget) +
-                        " available after the BVH); use --device cpu",
-                    "--backend cuda");
+                        " available after the BVH); bake on the CPU",
+                    "device");
     const std::uint64_t grid = (std::uint64_t(0x7fffffff) * kBlock) / slots; // a launch has < 2^31 blocks
-    const auto chunk = std::uint32_t(std::clamp<std::uint64_t>(std::min({work, fit, grid}), 1, std::max(n, 1u)));
-
-    GpuBakeParams base = host_params(plan, m.bvh);
-    base.bvh = m.device_view();
-    base.soup = m.soup.data();
-    base.points = d_points.data();
-    base.weights = d_weights.data();
-    base.order = d_order.data();
-
-    ChunkSlot slots_[2];
-    const std::uint32_t nslots = n > chunk ? 2 : 1;
-    try {
-        for (std::uint32_t k = 0; k < nslots; ++k)
-            slots_[k].allocate(chunk, words, s.rotate, s.store_bits);
-    } catch (const Error&) {
-        throw Error("cannot allocate the bake's buffers on " + m.device + " (" + std::to_string(nslots) +
-                        " chunks of " + std::to_string(chunk) + " vertices, " +
-                        mib(std::uint64_t(nslots) * chunk * per_vertex) + "); free GPU memory, or use --device cpu",
-                    "--backend cuda");
-    }
-
-    Progress progress("ao", n);
-    // Waits for a slot's chunk and stores its results.
-    auto drain = [&](ChunkSlot& c) {
-        if (!c.busy)
-            return;
-        SKYBAKE_CUDA_CHECK(cudaStreamSynchronize(c.stream));
-        store_chunk(plan, c.first, c.count,
-                    {c.h_ao.data(), c.h_shading.data(), c.h_bent.data(), c.h_rays.data(), c.h_clamped.data(),
-                     s.store_bits ? c.h_rule_words.data() : nullptr},
-                    out);
-        c.busy = false;
-        progress.advance(c.count);
-    };
-
-    out.rays = 0;
-    out.clamped_vertices = 0;
-    m.chunks = 0;
-    for (std::uint32_t first = 0; first < n; first += chunk, ++m.chunks) {
-        ChunkSlot& c = slots_[m.chunks % nslots];
-        drain(c); // its previous chunk, while the other slot's kernels run
-        const std::uint32_t count = std::min(chunk, n - first);
-        c.first = first;
-        c.count = count;
-        std::copy_n(plan.origins.data() + first, count, c.h_origins.data());
-        std::copy_n(plan.normals.data() + first, count, c.h_normals.data());
-        if (s.rotate)
-            std::copy_n(plan.rotations.data() + first, count, c.h_rotations.data());
-        const cudaStream_t st = c.stream;
-        c.origins.upload_prefix(c.h_origins.data(), count, st);
-        c.normals.upload_prefix(c.h_normals.data(), count, st);
-        if (s.rotate)
-            c.rotations.upload_prefix(c.h_rotations.data(), count, st);
-        if (s.store_bits)
-            SKYBAKE_CUDA_CHECK(cudaMemsetAsync(c.rule_words.data(), 0, std::size_t(count) * words * 4, st));
-
-        GpuBakeParams p = base;
-        p.vertex_count = count;
-        p.origins = c.origins.data();
-        p.normals = c.normals.data();
-        p.rotations = s.rotate ? c.rotations.data() : nullptr;
-        p.visit_words = c.visit_words.data();
-        p.ao = c.ao.data();
-        p.shading = c.shading.data();
-        p.bent = c.bent.data();
-        p.rays = c.rays.data();
-        p.clamped = c.clamped.data();
-        p.rule_words = s.store_bits ? c.rule_words.data() : nullptr;
-
-        const std::uint64_t threads = std::uint64_t(count) * words * 32;
-        const auto blocks = unsigned((threads + kBlock - 1) / kBlock);
-        switch (options.method) {
-        case TraceMethod::Bvh: trace_kernel<TraceMethod::Bvh><<<blocks, kBlock, 0, st>>>(p); break;
-        case TraceMethod::PerVertex: trace_kernel<TraceMethod::PerVertex><<<blocks, kBlock, 0, st>>>(p); break;
-        case TraceMethod::PerPolygon: trace_tiled_kernel<<<blocks, kBlock, 0, st>>>(p); break;
-        default: throw Error("unknown trace method " + std::to_string(int(options.method)), "--method");
-        }
-        SKYBAKE_CUDA_CHECK(cudaGetLastError());
-        reduce_kernel<<<cuda::grid_for(std::size_t(count) * kReduceLanes, kBlock), kBlock, 0, st>>>(p);
-        SKYBAKE_CUDA_CHECK(cudaGetLastError());
-
-        c.ao.download(c.h_ao.data(), count, st);
-        c.shading.download(c.h_shading.data(), count, st);
-        c.bent.download(c.h_bent.data(), count, st);
-        c.rays.download(c.h_rays.data(), count, st);
-        c.clamped.download(c.h_clamped.data(), count, st);
-        if (s.store_bits)
-            c.rule_words.download(c.h_rule_words.data(), std::size_t(count) * words, st);
-        c.busy = true;
-    }
-    for (std::uint32_t k = 0; k < nslots; ++k)
-        drain(slots_[k]);
-    progress.finish();
-    out.trace_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+    m.chunk_limit = std::uint32_t(std::clamp<std::uint64_t>(std::min({work, fit, grid}), 1, 0xffffffffu));
+    return m.chunk_limit;
 }
 
-std::unique_ptr<VisibilityBackend> make_cuda_backend() {
+void CudaBackend::trace(const TraceChunk& chunk) {
+    Impl& m = *impl_;
+    const TraceRule& rule = m.rule;
+    const std::uint32_t words = rule.words_per_vertex, count = chunk.count;
+    if (count > m.chunk_limit)
+        throw Error("a chunk of " + std::to_string(count) + " vertices is more than set_rule() allowed (" +
+                        std::to_string(m.chunk_limit) + ")",
+                    "count");
+    try {
+        m.origins.upload(chunk.origins.data(), count);
+        m.normals.upload(chunk.normals.data(), count);
+        if (rule.rotate)
+            m.rotations.upload(chunk.rotations.data(), count);
+        m.visit_words.resize(std::size_t(count) * words);
+        m.rule_words.resize(std::size_t(count) * words);
+    } catch (const Error&) {
+        throw Error("cannot allocate the bake's buffers on " + m.device + " (a chunk of " + std::to_string(count) +
+                        " vertices, " + mib(std::uint64_t(count) * bytes_per_vertex(words, rule.rotate)) +
+                        "); free GPU memory, or bake on the CPU",
+                    "device");
+    }
+
+    GpuTraceParams p = trace_params(rule, m.position.data(), m.bvh, m.cull_back);
+    p.bvh = m.device_view();
+    p.soup = m.soup.data();
+    p.points = m.points.data();
+    p.vertex_count = count;
+    p.origins = m.origins.data();
+    p.normals = m.normals.data();
+    p.rotations = rule.rotate ? m.rotations.data() : nullptr;
+    p.visit_words = m.visit_words.data();
+    p.rule_words = m.rule_words.data();
+
+    const std::uint64_t threads = std::uint64_t(count) * words * 32;
+    const auto blocks = unsigned((threads + kBlock - 1) / kBlock);
+    switch (m.method) {
+    case TraceMethod::Bvh: trace_kernel<TraceMethod::Bvh><<<blocks, kBlock>>>(p); break;
+    case TraceMethod::PerVertex: trace_kernel<TraceMethod::PerVertex><<<blocks, kBlock>>>(p); break;
+    case TraceMethod::PerPolygon: trace_tiled_kernel<<<blocks, kBlock>>>(p); break;
+    default: throw Error("unknown trace method " + std::to_string(int(m.method)), "method");
+    }
+    SKYBAKE_CUDA_CHECK(cudaGetLastError());
+    gather_kernel<<<cuda::grid_for(std::size_t(count) * words, kBlock), kBlock>>>(p);
+    SKYBAKE_CUDA_CHECK(cudaGetLastError());
+    if (!chunk.words.empty())
+        m.rule_words.download(chunk.words.data(), std::size_t(count) * words);
+    SKYBAKE_CUDA_CHECK(cudaDeviceSynchronize());
+    ++m.chunks;
+}
+
+std::unique_ptr<RayQueries> make_cuda_ray_queries() {
     return std::make_unique<CudaBackend>();
+}
+
+std::unique_ptr<VisibilityTracer> make_cuda_tracer(TraceMethod method) {
+    return std::make_unique<CudaBackend>(method);
 }
 
 } // namespace skybake::visibility

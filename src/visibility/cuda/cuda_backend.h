@@ -2,9 +2,10 @@
 // without CUDA; the class exists only in builds that have it.
 //
 // set_mesh() builds the BVH on the CPU (cuda/bvh.h) and uploads it with the
-// triangle soup. bake() runs the kernels of cuda_backend.cu over chunks of
-// vertices on two streams, so that one chunk's transfers overlap the other's
-// kernels; occluded() and intersect() trace batches of rays.
+// triangle soup. trace() runs the kernels of cuda_backend.cu over one chunk of
+// vertices and leaves the words in device memory (device_words()), copying
+// them back when the chunk asks; occluded() and intersect() trace batches of
+// rays.
 #pragma once
 
 #include <cstdint>
@@ -15,14 +16,15 @@
 
 namespace skybake::visibility {
 
-// Creates the CUDA backend on device 0. Throws skybake::Error naming
-// "--backend cuda" when the build has no CUDA or the machine no CUDA device.
-std::unique_ptr<VisibilityBackend> make_cuda_backend();
+// Create the CUDA backend on device 0. Throw skybake::Error (where: "device")
+// when the build has no CUDA or the machine no CUDA device.
+std::unique_ptr<RayQueries> make_cuda_ray_queries();
+std::unique_ptr<VisibilityTracer> make_cuda_tracer(TraceMethod method);
 
 #if defined(SKYBAKE_HAS_CUDA)
 struct Bvh;
 
-class CudaBackend final : public VisibilityBackend {
+class CudaBackend final : public RayQueries, public VisibilityTracer {
 public:
     // Work and memory per launch. The defaults keep each kernel well under a
     // second on current GPUs (the seed's watchdog concern) and leave the rest
@@ -33,7 +35,7 @@ public:
         std::uint64_t memory_bytes = 0; // device memory the backend may use; 0: 90% of what is free
     };
 
-    CudaBackend();
+    explicit CudaBackend(TraceMethod method = TraceMethod::Bvh);
     ~CudaBackend() override;
     CudaBackend(const CudaBackend&) = delete;
     CudaBackend& operator=(const CudaBackend&) = delete;
@@ -42,12 +44,17 @@ public:
     void set_mesh(const Mesh& mesh, BackFaces back_faces) override;
     void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const override;
     void intersect(std::span<const Ray> rays, std::span<RayHit> hits) const override;
-    void bake(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options, BakeOutputs& out) override;
+    TraceMethod method() const override;
+    std::string device_name() const override;
+    std::uint32_t set_rule(const TraceRule& rule) override;
+    void trace(const TraceChunk& chunk) override;
+    bool device_words_supported() const override { return true; }
+    const std::uint32_t* device_words() const override;
 
+    // Set before set_rule(), which sizes chunks by them.
     void set_limits(const Limits& limits);
     const Limits& limits() const;
-    std::string device_name() const;
-    // Chunks (kernel launches of each kind) of the last bake.
+    // trace() calls (kernel launches of each kind) since the last set_rule().
     std::uint32_t last_chunk_count() const;
     // The BVH of the current mesh (host copy).
     const Bvh& bvh() const;

@@ -6,11 +6,16 @@
 
 namespace skybake::visibility {
 
-std::unique_ptr<VisibilityBackend> make_cuda_backend() {
+namespace {
+[[noreturn]] void no_cuda() {
     throw Error("this build has no CUDA support; rebuild with the CUDA toolkit installed (nvcc on PATH or in "
-                "/usr/local/cuda), or use --device cpu",
-                "--backend cuda");
+                "/usr/local/cuda), or bake on the CPU",
+                "device");
 }
+} // namespace
+
+std::unique_ptr<RayQueries> make_cuda_ray_queries() { no_cuda(); }
+std::unique_ptr<VisibilityTracer> make_cuda_tracer(TraceMethod) { no_cuda(); }
 
 } // namespace skybake::visibility
 #endif

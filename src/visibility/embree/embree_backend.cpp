@@ -3,21 +3,20 @@
 // Wald I., Woop S., Benthin C., Johnson G. S., Ernst M. Embree: a kernel
 // framework for efficient CPU ray tracing. ACM TOG 33(4), SIGGRAPH 2014.
 //
-// The bake casts, for each vertex, the rule directions on or above its horizon
+// trace() casts, for each vertex, the rule directions on or above its horizon
 // from one origin. Directions are visited in a fixed coherent order (Morton
 // order of the octahedral map, bake_common.h). With a large rule they are issued
 // as 16-ray packets (rtcOccluded16, coherent context flag): rays of one packet
 // share the origin and point into a small patch of the sphere, so they traverse
 // the BVH together. With a small rule a packet would spread over the whole sky
 // and single rays (rtcOccluded1) are faster.
-// Vertices are spread over TBB tasks; each vertex's result depends on that vertex
-// alone, so the output does not depend on the thread count.
+// Vertices are spread over TBB tasks; each vertex's words depend on that vertex
+// alone, so they do not depend on the chunking or the thread count.
 #include "visibility/embree/embree_backend.h"
 
 #include <algorithm>
 #include <atomic>
 #include <cassert>
-#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -25,12 +24,10 @@
 #include <glm/geometric.hpp>
 
 #include "core/parallel.h"
-#include "core/progress.h"
 #include "skybake/error.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
-#include "visibility/bake_common.h"
-#include "visibility/shading_hd.h"
+#include "visibility/trace_hd.h"
 
 namespace skybake::visibility {
 
@@ -87,7 +84,7 @@ void set_lane(RTCRay16& r, int lane, const glm::vec3& o, const glm::vec3& d, flo
 EmbreeBackend::EmbreeBackend() {
     device_ = rtcNewDevice("verbose=0");
     if (!device_)
-        throw Error(fmt::format("cannot start Embree: {}", error_name(rtcGetDeviceError(nullptr))), "embree");
+        throw Error(fmt::format("cannot start Embree: {}", error_name(rtcGetDeviceError(nullptr))), "backend");
     rtcSetDeviceErrorFunction(device_, &EmbreeBackend::error_callback, this);
 }
 
@@ -116,8 +113,8 @@ void EmbreeBackend::check(const char* what) {
     if (code == RTC_ERROR_OUT_OF_MEMORY)
         throw Error(fmt::format("Embree ran out of memory while {}; use a smaller mesh or a machine with more memory",
                                 what),
-                    "embree");
-    throw Error(fmt::format("Embree failed while {}: {}", what, detail), "embree");
+                    "backend");
+    throw Error(fmt::format("Embree failed while {}: {}", what, detail), "backend");
 }
 
 // Occlusion and intersection filter for BackFaces::Ignore: a candidate hit on
@@ -153,7 +150,7 @@ void EmbreeBackend::set_mesh(const Mesh& mesh, BackFaces back_faces) {
         rtcReleaseGeometry(geom);
         rtcReleaseScene(scene);
         check("allocating the mesh buffers");
-        throw Error("Embree could not allocate the mesh buffers", "embree");
+        throw Error("Embree could not allocate the mesh buffers", "backend");
     }
     for (std::size_t v = 0; v < nv; ++v) {
         vb[3 * v] = mesh.positions[v].x;
@@ -244,76 +241,71 @@ void EmbreeBackend::intersect(std::span<const Ray> rays, std::span<RayHit> hits)
     });
 }
 
-void EmbreeBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options, BakeOutputs& out) {
-    require_bvh_method(options, name());
-    const BakeSetup s = prepare_bake(mesh, rule, options, out);
-    const auto t0 = std::chrono::steady_clock::now();
-    set_mesh(mesh, options.back_faces);
-    const auto t1 = std::chrono::steady_clock::now();
-    out.build_seconds = std::chrono::duration<double>(t1 - t0).count();
+std::uint32_t EmbreeBackend::set_rule(const TraceRule& rule) {
+    rule_ = rule;
+    // Without rotation every vertex has the same directions: keep one copy,
+    // structure of arrays.
+    const auto directions = std::uint32_t(rule.points.size());
+    fixed_x_.resize(directions);
+    fixed_y_.resize(directions);
+    fixed_z_.resize(directions);
+    for (std::uint32_t j = 0; j < directions; ++j) {
+        fixed_x_[j] = rule.points[j].x;
+        fixed_y_[j] = rule.points[j].y;
+        fixed_z_[j] = rule.points[j].z;
+    }
+    return 0xffffffffu;
+}
 
-    const std::uint32_t padded = padded_directions(s.directions);
-    const std::size_t n = mesh.vertex_count();
+void EmbreeBackend::trace(const TraceChunk& chunk) {
+    assert(scene_);
+    const TraceRule& rule = rule_;
+    const auto directions = std::uint32_t(rule.points.size());
+    const std::uint32_t words_per_vertex = rule.words_per_vertex;
     const float inf = std::numeric_limits<float>::infinity();
-    Progress progress("ao", n);
-    std::atomic<std::uint64_t> rays{0}, clamped{0};
     // Packets pay when a vertex's rays are many, so that 16 consecutive ones in
     // the coherent order point into a small patch of sky; with few directions
     // single rays are faster (docs/PERFORMANCE.md).
-    const bool packets = s.directions >= kPacketMinDirections;
-    // Without rotation every vertex has the same directions: keep one copy.
-    std::vector<float> fixed_x(padded, 0.0f), fixed_y(padded, 0.0f), fixed_z(padded, 0.0f);
-    for (std::uint32_t j = 0; j < s.directions; ++j) {
-        fixed_x[j] = s.sorted_points[j].x;
-        fixed_y[j] = s.sorted_points[j].y;
-        fixed_z[j] = s.sorted_points[j].z;
-    }
+    const bool packets = directions >= kPacketMinDirections;
     // Tasks of about 8k directions: enough to hide the scratch set-up.
-    const std::size_t grain = std::clamp<std::size_t>(8192 / s.directions, 4, 256);
-    parallel_for(n, grain, [&](std::size_t b, std::size_t e) {
+    const std::size_t grain = std::clamp<std::size_t>(8192 / std::max<std::uint32_t>(directions, 1), 4, 256);
+    parallel_for(chunk.count, grain, [&](std::size_t b, std::size_t e) {
         RTCIntersectContext ctx = coherent_context(), ctx1 = incoherent_context();
         alignas(64) RTCRay16 r;
         alignas(64) int valid[kPacket];
-        std::vector<std::uint32_t> words(s.words);
-        // Per-direction scratch in visiting order, structure of arrays,
-        // zero-padded to `padded`.
-        std::vector<float> cs(padded, 0.0f), vis(padded), rx, ry, rz;
-        if (s.rotate) {
-            rx.assign(padded, 0.0f);
-            ry.assign(padded, 0.0f);
-            rz.assign(padded, 0.0f);
+        // Per-direction scratch in visiting order, structure of arrays.
+        std::vector<float> cs(directions), rx, ry, rz;
+        if (rule.rotate) {
+            rx.resize(directions);
+            ry.resize(directions);
+            rz.resize(directions);
         }
-        float* xs = s.rotate ? rx.data() : fixed_x.data();
-        float* ys = s.rotate ? ry.data() : fixed_y.data();
-        float* zs = s.rotate ? rz.data() : fixed_z.data();
-        std::vector<std::uint32_t> sel(s.directions);
+        const float* xs = rule.rotate ? rx.data() : fixed_x_.data();
+        const float* ys = rule.rotate ? ry.data() : fixed_y_.data();
+        const float* zs = rule.rotate ? rz.data() : fixed_z_.data();
+        std::vector<std::uint32_t> sel(directions);
         std::vector<RTCRay> ray1;
-        std::uint64_t traced = 0;
-        for (std::size_t v = b; v < e; ++v) {
-            const VertexFrame f = vertex_frame(s, mesh, std::uint32_t(v));
-            // Directions and cosines once per vertex; the reduction reuses them.
-            if (s.rotate) {
-                for (std::uint32_t j = 0; j < s.directions; ++j) {
-                    glm::vec3 x;
-                    vertex_direction(s.sorted_points[j], f.rotation, true, f.normal, x, cs[j]);
-                    xs[j] = x.x;
-                    ys[j] = x.y;
-                    zs[j] = x.z;
-                }
-            } else {
-                for (std::uint32_t j = 0; j < s.directions; ++j) {
-                    glm::vec3 x;
-                    vertex_direction(s.sorted_points[j], f.rotation, false, f.normal, x, cs[j]);
+        for (std::size_t i = b; i < e; ++i) {
+            const glm::vec3 origin = chunk.origins[i], normal = chunk.normals[i];
+            const glm::mat3 rotation = rule.rotate ? chunk.rotations[i] : glm::mat3(1.0f);
+            std::uint32_t* words = chunk.words.data() + i * words_per_vertex;
+            std::fill(words, words + words_per_vertex, 0u);
+            // Directions and cosines once per vertex.
+            for (std::uint32_t j = 0; j < directions; ++j) {
+                glm::vec3 x;
+                vertex_direction(rule.points[j], rotation, rule.rotate, normal, x, cs[j]);
+                if (rule.rotate) {
+                    rx[j] = x.x;
+                    ry[j] = x.y;
+                    rz[j] = x.z;
                 }
             }
-            std::fill(words.begin(), words.end(), 0u);
-            std::fill(vis.begin(), vis.end(), 0.0f);
             // All rays of the vertex share origin and interval: set those lanes once.
             for (int l = 0; l < kPacket; ++l)
-                set_lane(r, l, f.origin, f.normal, 0.0f, s.t_max);
+                set_lane(r, l, origin, normal, 0.0f, rule.t_max);
             // Branch-free selection of the directions on or above the horizon ...
             std::uint32_t m = 0;
-            for (std::uint32_t j = 0; j < s.directions; ++j) {
+            for (std::uint32_t j = 0; j < directions; ++j) {
                 sel[m] = j;
                 m += std::uint32_t(needs_ray(cs[j]));
             }
@@ -322,37 +314,36 @@ void EmbreeBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOpt
                 // sky), set up first and traced in one tight loop, which measured
                 // 15% faster than interleaving set-up and calls.
                 ray1.resize(m);
-                for (std::uint32_t i = 0; i < m; ++i) {
-                    const std::uint32_t j = sel[i];
-                    RTCRay& one = ray1[i];
-                    one.org_x = f.origin.x;
-                    one.org_y = f.origin.y;
-                    one.org_z = f.origin.z;
+                for (std::uint32_t q = 0; q < m; ++q) {
+                    const std::uint32_t j = sel[q];
+                    RTCRay& one = ray1[q];
+                    one.org_x = origin.x;
+                    one.org_y = origin.y;
+                    one.org_z = origin.z;
                     one.tnear = 0.0f;
                     one.dir_x = xs[j];
                     one.dir_y = ys[j];
                     one.dir_z = zs[j];
                     one.time = 0.0f;
-                    one.tfar = s.t_max;
+                    one.tfar = rule.t_max;
                     one.mask = 0xffffffffu;
                     one.id = 0;
                     one.flags = 0;
                 }
-                for (std::uint32_t i = 0; i < m; ++i)
-                    rtcOccluded1(scene_, &ctx1, &ray1[i]);
-                for (std::uint32_t i = 0; i < m; ++i)
-                    if (ray1[i].tfar != -inf) {
-                        set_bit(words.data(), s.order[sel[i]]);
-                        vis[sel[i]] = 1.0f;
-                    }
+                for (std::uint32_t q = 0; q < m; ++q)
+                    rtcOccluded1(scene_, &ctx1, &ray1[q]);
+                for (std::uint32_t q = 0; q < m; ++q)
+                    if (ray1[q].tfar != -inf)
+                        set_bit(words, rule.order[sel[q]]);
+                continue;
             }
             // ... or 16 at a time. Occluded lanes come back with tfar = -inf.
-            for (std::uint32_t base = 0; packets && base < m; base += kPacket) {
+            for (std::uint32_t base = 0; base < m; base += kPacket) {
                 const int count = int(std::min<std::uint32_t>(kPacket, m - base));
                 const std::uint32_t* lane_j = sel.data() + base;
                 for (int l = 0; l < kPacket; ++l) {
                     valid[l] = l < count ? -1 : 0;
-                    r.tfar[l] = s.t_max;
+                    r.tfar[l] = rule.t_max;
                 }
                 for (int l = 0; l < count; ++l) {
                     r.dir_x[l] = xs[lane_j[l]];
@@ -361,24 +352,11 @@ void EmbreeBackend::bake(const Mesh& mesh, const SphereRule& rule, const BakeOpt
                 }
                 rtcOccluded16(valid, scene_, &ctx, &r);
                 for (int l = 0; l < count; ++l)
-                    if (r.tfar[l] != -inf) {
-                        set_bit(words.data(), s.order[lane_j[l]]);
-                        vis[lane_j[l]] = 1.0f;
-                    }
+                    if (r.tfar[l] != -inf)
+                        set_bit(words, rule.order[lane_j[l]]);
             }
-            traced += m;
-            const Shading result = shading_from_arrays(xs, ys, zs, cs.data(),
-                                                       s.sorted_weights.data(), vis.data(), padded, f.normal,
-                                                       s.normalize);
-            store_vertex(s, std::uint32_t(v), result, words.data(), out, clamped);
         }
-        rays += traced;
-        progress.advance(e - b);
     });
-    progress.finish();
-    out.rays = rays.load();
-    out.clamped_vertices = clamped.load();
-    out.trace_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
 }
 
 } // namespace skybake::visibility

@@ -13,7 +13,7 @@
 
 namespace skybake::visibility {
 
-class EmbreeBackend final : public VisibilityBackend {
+class EmbreeBackend final : public RayQueries, public VisibilityTracer {
 public:
     EmbreeBackend();
     ~EmbreeBackend() override;
@@ -24,7 +24,8 @@ public:
     void set_mesh(const Mesh& mesh, BackFaces back_faces) override;
     void occluded(std::span<const Ray> rays, std::span<std::uint8_t> occluded) const override;
     void intersect(std::span<const Ray> rays, std::span<RayHit> hits) const override;
-    void bake(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options, BakeOutputs& out) override;
+    std::uint32_t set_rule(const TraceRule& rule) override;
+    void trace(const TraceChunk& chunk) override;
 
     // The committed scene (nullptr before set_mesh), for benchmarks.
     RTCScene scene() const { return scene_; }
@@ -37,6 +38,8 @@ private:
     RTCDevice device_ = nullptr;
     RTCScene scene_ = nullptr;
     std::vector<glm::vec3> face_normals_; // front side, for BackFaces::Ignore
+    TraceRule rule_;
+    std::vector<float> fixed_x_, fixed_y_, fixed_z_; // the rule's directions, visiting order
     std::mutex error_mutex_;
     std::string last_error_;
 };

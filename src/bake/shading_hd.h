@@ -1,5 +1,7 @@
-// Shading coefficients from per-direction visibility, shared by every backend
-// (CPU now, CUDA kernels later: everything here is SKYBAKE_HD).
+// The shading reduction: one vertex's visibility words to its ambient
+// occlusion, shading coefficient A and bent normal. SKYBAKE_HD, so that the
+// bake driver runs it on the CPU and the CUDA kernel of shading_cuda.cu runs
+// it unchanged.
 //
 // Svistunov, GPU computation of shading coefficients for interactive lighting
 // (seed 002; docs/SEEDS-DIGEST.md). With the normalised measure dμ = dω/4π and a
@@ -8,11 +10,7 @@
 //     A  (shading coeff.)    = 2 ∫ V dμ        ≈ Σ_k w_k 2 H(n·x_k) V_k
 //     bent normal            = normalise(Σ_k w_k V_k (n·x_k)+ x_k)
 // where V_k = 1 when direction k is not below the horizon and unblocked, and
-// H is the step 1 above, ½ on and 0 below the horizon (see add_direction). The
-// seed's V is 0 below the horizon, so a visibility bit is never set there.
-//
-// Bit layout (also in skybake/visibility.h): uint32 words, direction k is bit
-// k % 32 of word k / 32; the seed used uint16 words of 16 directions.
+// H is the step 1 above, ½ on and 0 below the horizon (see add_direction).
 #pragma once
 
 #include <cmath>
@@ -23,36 +21,18 @@
 #include <glm/vec3.hpp>
 
 #include "core/hd.h"
+#include "visibility/trace_hd.h"
 
-namespace skybake::visibility {
+namespace skybake::bake {
 
-// [SECTION] Bits -------------------------------------------------------------------
-
-SKYBAKE_HD_INLINE std::uint32_t words_for_directions(std::uint32_t directions) { return (directions + 31u) / 32u; }
-
-SKYBAKE_HD_INLINE bool get_bit(const std::uint32_t* words, std::uint32_t k) { return (words[k >> 5] >> (k & 31u)) & 1u; }
-
-SKYBAKE_HD_INLINE void set_bit(std::uint32_t* words, std::uint32_t k) { words[k >> 5] |= 1u << (k & 31u); }
-
-// [SECTION] Per-vertex ray set-up -------------------------------------------------------
-
-// Direction k at a vertex: R·x_k for a rotated rule, else x_k (world space).
-SKYBAKE_HD_INLINE glm::vec3 rule_direction(const glm::mat3& rotation, bool rotate, const glm::vec3& x) {
-    return rotate ? rotation * x : x;
-}
-
-// Ray origin: the vertex moved by `offset` (mesh units) along its unit normal
-// and along `inward`, a unit tangent towards its own triangles for vertices on
-// a border or a crease (zero elsewhere; see vertex_inward_directions()).
-SKYBAKE_HD_INLINE glm::vec3 ray_origin(const glm::vec3& position, const glm::vec3& normal, const glm::vec3& inward,
-                                       float offset) {
-    return position + offset * (normal + inward);
-}
+using visibility::get_bit;
+using visibility::needs_ray;
+using visibility::vertex_direction;
 
 // [SECTION] Reduction -------------------------------------------------------------------
 //
 // The directions are visited in one fixed order, the rule's coherent order
-// (order[j] = k, see coherent_direction_order() in bake_common.h); the j-th one
+// (order[j] = k, see coherent_direction_order() in bake/driver.h); the j-th one
 // goes to partial sum j mod kReduceLanes, and the partials are added in lane
 // order at the end. Every backend follows this order, so all of them get the
 // same bits of float from the same visibility, and CPU loops vectorise.
@@ -100,9 +80,6 @@ SKYBAKE_HD_INLINE void add_direction(ShadingPartials& p, std::uint32_t lane, flo
     p.bz[lane] += b * z;
 }
 
-// Whether direction k needs a ray: on or above the horizon.
-SKYBAKE_HD_INLINE bool needs_ray(float cos_n) { return cos_n >= 0.0f; }
-
 SKYBAKE_HD_INLINE ShadingSums combine_partials(const ShadingPartials& p) {
     ShadingSums s;
     for (std::uint32_t l = 0; l < kReduceLanes; ++l) {
@@ -147,52 +124,29 @@ SKYBAKE_HD_INLINE Shading finish_shading(const ShadingSums& s, const glm::vec3& 
     return r;
 }
 
-// Direction k of a vertex and its cosine to the normal: the one place where
-// both are computed, so that every caller gets the same bits of float.
-SKYBAKE_HD_INLINE void vertex_direction(const glm::vec3& point, const glm::mat3& rotation, bool rotate,
-                                        const glm::vec3& normal, glm::vec3& x, float& cos_n) {
-    x = rule_direction(rotation, rotate, point);
-    cos_n = glm::dot(normal, x);
-}
-
-// The whole reduction for one vertex, from its visibility words (bit k for rule
-// direction k). points/weights: the rule in single precision; order: the
-// visiting order (a permutation of 0 ... K−1); normal: unit; rotation: the
-// vertex's rule rotation (ignored unless rotate).
-SKYBAKE_HD_INLINE Shading shading_from_bits(const std::uint32_t* words, const glm::vec3* points, const float* weights,
-                                            const std::uint32_t* order, std::uint32_t directions,
-                                            const glm::vec3& normal, const glm::mat3& rotation, bool rotate,
-                                            bool normalize) {
+// The whole reduction for one vertex. words: its visibility words, rule order
+// (skybake/visibility.h); points/weights: the rule in single precision, in
+// visiting order (points[j] is rule direction order[j]); normal: unit;
+// rotation: the vertex's rule rotation (ignored unless rotate). traced, when
+// given, receives the count of directions on or above the horizon (the rays).
+SKYBAKE_HD_INLINE Shading shading_from_words(const std::uint32_t* words, const glm::vec3* points, const float* weights,
+                                             const std::uint32_t* order, std::uint32_t directions,
+                                             const glm::vec3& normal, const glm::mat3& rotation, bool rotate,
+                                             bool normalize, std::uint32_t* traced = nullptr) {
     ShadingPartials p;
+    std::uint32_t rays = 0;
     for (std::uint32_t j0 = 0; j0 < directions; j0 += kReduceLanes)
         for (std::uint32_t l = 0; l < kReduceLanes && j0 + l < directions; ++l) {
-            const std::uint32_t k = order[j0 + l];
+            const std::uint32_t j = j0 + l;
             glm::vec3 x;
             float c;
-            vertex_direction(points[k], rotation, rotate, normal, x, c);
-            add_direction(p, l, weights[k], c, x.x, x.y, x.z, get_bit(words, k) ? 1.0f : 0.0f);
+            vertex_direction(points[j], rotation, rotate, normal, x, c);
+            add_direction(p, l, weights[j], c, x.x, x.y, x.z, get_bit(words, order[j]) ? 1.0f : 0.0f);
+            rays += needs_ray(c) ? 1u : 0u;
         }
+    if (traced)
+        *traced = rays;
     return finish_shading(combine_partials(p), normal, normalize);
 }
 
-// Same, from arrays in visiting order already filled by vertex_direction()
-// (x, y, z, cos_n of the j-th direction), its weight and visible[j] = 1 or 0,
-// each padded with zeros to a multiple of kReduceLanes entries: the same
-// arithmetic in the same order, so the same result.
-SKYBAKE_HD_INLINE Shading shading_from_arrays(const float* x, const float* y, const float* z, const float* cos_n,
-                                              const float* weights, const float* visible, std::uint32_t padded,
-                                              const glm::vec3& normal, bool normalize) {
-    ShadingPartials p;
-    for (std::uint32_t j0 = 0; j0 < padded; j0 += kReduceLanes)
-        for (std::uint32_t l = 0; l < kReduceLanes; ++l) {
-            const std::uint32_t j = j0 + l;
-            add_direction(p, l, weights[j], cos_n[j], x[j], y[j], z[j], visible[j]);
-        }
-    return finish_shading(combine_partials(p), normal, normalize);
-}
-
-SKYBAKE_HD_INLINE std::uint32_t padded_directions(std::uint32_t directions) {
-    return (directions + kReduceLanes - 1) / kReduceLanes * kReduceLanes;
-}
-
-} // namespace skybake::visibility
+} // namespace skybake::bake

@@ -9,8 +9,8 @@
 
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
-#include "visibility/cuda/bake_plan.h"
-#include "visibility/cuda/test_scenes.h"
+#include "bake/cuda_bake_test_util.h"
+#include "skybake/bake.h"
 
 using namespace skybake;
 using namespace skybake::visibility;
@@ -25,7 +25,7 @@ void check(const std::string& label, const Mesh& m, const char* spec, bool tie_f
     o.store_bits = true;
     BakeOutputs e;
     EmbreeBackend embree;
-    embree.bake(m, rule, o, e);
+    bake_shading(m, rule, embree, o, e);
     const BakeOutputs g = emulated(m, rule, o, TraceMethod::Bvh);
     const Agreement a = compare_bakes(m, rule, o, g, e);
     a.print((label + " " + spec + ", host emulation").c_str());
@@ -42,7 +42,7 @@ TEST(CudaBakeSlow, RealModelsMatchEmbree) {
 }
 
 TEST(CudaBakeSlow, SeedTableCaseMatchesEmbree) {
-    check("city", ao_test::generated(ProceduralKind::City, 3000), "lebedev:5810", false);
+    check("city", generated(ProceduralKind::City, 3000), "lebedev:5810", false);
 }
 
 TEST(CudaBakeSlow, TheGpuTestsSettingsPassOnTheHost) {
@@ -58,7 +58,10 @@ TEST(CudaBakeSlow, TheGpuTestsSettingsPassOnTheHost) {
                 o.store_bits = true;
                 o.back_faces = back;
                 BakeOutputs e;
-                EmbreeBackend().bake(m, rule, o, e);
+                {
+            EmbreeBackend embree;
+            bake_shading(m, rule, embree, o, e);
+        }
                 const Agreement a = compare_bakes(m, rule, o, emulated(m, rule, o, TraceMethod::Bvh), e);
                 a.print(label.c_str());
                 expect_agreement(a, tie_free(name, rule));
@@ -77,7 +80,10 @@ TEST(CudaBakeSlow, TheGpuTestsRealModelsPassOnTheHost) {
         BakeOptions o;
         o.store_bits = true;
         BakeOutputs e;
-        EmbreeBackend().bake(m, rule, o, e);
+        {
+            EmbreeBackend embree;
+            bake_shading(m, rule, embree, o, e);
+        }
         const Agreement a = compare_bakes(m, rule, o, emulated(m, rule, o, TraceMethod::Bvh), e);
         a.print((std::string(label) + " " + spec + ", host emulation").c_str());
         expect_agreement(a, true);
@@ -88,13 +94,16 @@ TEST(CudaBakeSlow, TheGpuCliTestsMeshesPassOnTheHost) {
     // tests/ao_gpu_test.cpp: a 5,000-triangle city and spider.obj at
     // lebedev:1202 (no rotation), at most 1e-4 of the bits differing and mean
     // AO within 1e-4.
-    const Mesh city = ao_test::generated(ProceduralKind::City, 5000), spider_mesh = spider();
+    const Mesh city = generated(ProceduralKind::City, 5000), spider_mesh = spider();
     for (const auto& [label, m] : {std::pair<const char*, const Mesh&>{"city", city}, {"spider", spider_mesh}}) {
         const SphereRule rule = parse_rule("lebedev:1202");
         BakeOptions o;
         o.store_bits = true;
         BakeOutputs e;
-        EmbreeBackend().bake(m, rule, o, e);
+        {
+            EmbreeBackend embree;
+            bake_shading(m, rule, embree, o, e);
+        }
         const BakeOutputs g = emulated(m, rule, o, TraceMethod::Bvh);
         const Agreement a = compare_bakes(m, rule, o, g, e);
         a.print((std::string(label) + " lebedev:1202, host emulation").c_str());

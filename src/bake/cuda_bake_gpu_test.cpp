@@ -1,6 +1,6 @@
 // The CUDA backend on a GPU (every test skips without a CUDA device):
 //  - every method against the Embree backend: at least 99.99% of the bits
-//    equal and AO within 1e-4 (expect_agreement in test_scenes.h);
+//    equal and AO within 1e-4 (expect_agreement in cuda_bake_test_util.h);
 //  - against its own host emulation (the same thread bodies on the CPU): the
 //    same bits, and AO equal to the float (the kernels are built without
 //    contracted multiply-adds);
@@ -14,10 +14,10 @@
 #include <tuple>
 
 #include "skybake/error.h"
-#include "visibility/cuda/bake_plan.h"
-#include "visibility/cuda/cuda_backend.h"
-#include "visibility/cuda/test_scenes.h"
+#include "bake/cuda_bake_test_util.h"
 #include "core/gpu_test.h"
+#include "skybake/bake.h"
+#include "visibility/cuda/cuda_backend.h"
 
 using namespace skybake;
 using namespace skybake::visibility;
@@ -26,9 +26,17 @@ using namespace skybake::visibility_test;
 namespace {
 
 
-BakeOutputs gpu_bake(CudaBackend& cuda, const Mesh& m, const SphereRule& rule, const BakeOptions& o) {
+// A bake with `cuda` as the tracer, with its method.
+BakeOutputs gpu_bake(CudaBackend& cuda, const Mesh& m, const SphereRule& rule, BakeOptions o) {
     BakeOutputs out;
-    cuda.bake(m, rule, o, out);
+    o.method = cuda.method();
+    bake_shading(m, rule, cuda, o, out);
+    return out;
+}
+
+BakeOutputs embree_bake(const Mesh& m, const SphereRule& rule, const BakeOptions& o) {
+    BakeOutputs out;
+    bake_shading(m, rule, *make_visibility_tracer("embree"), o, out);
     return out;
 }
 
@@ -45,8 +53,7 @@ void expect_same(const BakeOutputs& a, const BakeOutputs& b) {
 
 TEST(CudaBackendGpu, EveryMethodMatchesEmbreeAndTheHostEmulation) {
     SKYBAKE_SKIP_WITHOUT_GPU();
-    CudaBackend cuda;
-    std::printf("device: %s\n", cuda.device_name().c_str());
+    std::printf("device: %s\n", CudaBackend().device_name().c_str());
     for (const auto& [name, m] : scenes())
         for (const char* spec : gpu_test_rules())
             for (BackFaces back : gpu_test_back_faces()) {
@@ -54,14 +61,13 @@ TEST(CudaBackendGpu, EveryMethodMatchesEmbreeAndTheHostEmulation) {
                 BakeOptions o;
                 o.store_bits = true;
                 o.back_faces = back;
-                BakeOutputs e;
-                make_visibility_backend("embree")->bake(m, rule, o, e);
+                const BakeOutputs e = embree_bake(m, rule, o);
                 const BakeOutputs host = emulated(m, rule, o, TraceMethod::Bvh);
                 for (TraceMethod method : {TraceMethod::Bvh, TraceMethod::PerVertex, TraceMethod::PerPolygon}) {
                     const std::string label =
                         name + " " + spec + " " + back_faces_name(back) + " " + trace_method_name(method);
                     SCOPED_TRACE(label);
-                    o.method = method;
+                    CudaBackend cuda(method);
                     const BakeOutputs g = gpu_bake(cuda, m, rule, o);
                     const Agreement a = compare_bakes(m, rule, o, g, e);
                     a.print(label.c_str());
@@ -76,19 +82,17 @@ TEST(CudaBackendGpu, RealModelsMatchEmbree) {
     const std::string models = SKYBAKE_ASSIMP_MODELS;
     const Mesh engine = load_mesh(models + "/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb");
     const Mesh wuson = load_mesh(models + "/OBJ/WusonOBJ.obj");
-    CudaBackend cuda;
     for (const auto& [name, m, spec] :
          {std::tuple<const char*, const Mesh&, const char*>{"engine", engine, "lebedev:110+rotate"},
           {"wuson", wuson, "lebedev:5810"}}) {
         const SphereRule rule = parse_rule(spec);
         BakeOptions o;
         o.store_bits = true;
-        BakeOutputs e;
-        make_visibility_backend("embree")->bake(m, rule, o, e);
+        const BakeOutputs e = embree_bake(m, rule, o);
         for (TraceMethod method : {TraceMethod::Bvh, TraceMethod::PerVertex, TraceMethod::PerPolygon}) {
             const std::string label = std::string(name) + " " + spec + " " + trace_method_name(method);
             SCOPED_TRACE(label);
-            o.method = method;
+            CudaBackend cuda(method);
             const BakeOutputs g = gpu_bake(cuda, m, rule, o);
             const Agreement a = compare_bakes(m, rule, o, g, e);
             a.print(label.c_str());
@@ -128,15 +132,15 @@ TEST(CudaBackendGpu, RayQueriesEqualTheHostTraversal) {
 
 TEST(CudaBackendGpu, ChunkedLaunchesAndRepeatedRunsGiveTheSameResult) {
     SKYBAKE_SKIP_WITHOUT_GPU();
-    const Mesh m = ao_test::generated(ProceduralKind::City, 20000);
+    const Mesh m = generated(ProceduralKind::City, 20000);
     const SphereRule rule = parse_rule("lebedev:1202+rotate");
     BakeOptions o;
     o.store_bits = true;
     CudaBackend cuda;
     const BakeOutputs one = gpu_bake(cuda, m, rule, o);
     // The default limit is work-bound here: 2^25 slots of 32 × 38 words give
-    // 27,594 vertices a launch, and the city has 34,116, so two chunks run, one
-    // on each stream (memory is not the bound on any current GPU).
+    // 27,594 vertices a launch, and the city has 34,116, so two chunks run
+    // (memory is not the bound on any current GPU).
     const std::uint64_t words = (rule.size() + 31) / 32;
     const auto per_chunk = std::uint32_t(CudaBackend::Limits{}.slots_per_launch / (32 * words));
     const auto n = std::uint32_t(m.vertex_count());
@@ -150,53 +154,52 @@ TEST(CudaBackendGpu, ChunkedLaunchesAndRepeatedRunsGiveTheSameResult) {
     EXPECT_EQ(cuda.last_chunk_count(), (std::uint32_t(m.vertex_count()) + 100) / 101);
     expect_same(chunked, one);
     for (TraceMethod method : {TraceMethod::PerVertex, TraceMethod::PerPolygon}) {
+        CudaBackend brute(method);
         small.tests_per_launch = 32ull * 38 * 7 * m.triangle_count(); // 7 vertices per chunk
-        cuda.set_limits(small);
-        o.method = method;
-        const BakeOutputs b = gpu_bake(cuda, m, rule, o);
-        EXPECT_GT(cuda.last_chunk_count(), 100u);
+        brute.set_limits(small);
+        const BakeOutputs b = gpu_bake(brute, m, rule, o);
+        EXPECT_GT(brute.last_chunk_count(), 100u);
         expect_same(b, one);
     }
 }
 
 TEST(CudaBackendGpu, TooLittleMemoryIsAClearErrorOrSmallerChunks) {
     SKYBAKE_SKIP_WITHOUT_GPU();
-    const Mesh m = ao_test::generated(ProceduralKind::Terrain, 50000);
+    const Mesh m = generated(ProceduralKind::Terrain, 50000);
     const SphereRule rule = parse_rule("lebedev:590");
     CudaBackend cuda;
     CudaBackend::Limits tiny;
     tiny.memory_bytes = 64 << 10; // 64 KiB: not even the BVH
     cuda.set_limits(tiny);
     try {
-        BakeOutputs out;
-        cuda.bake(m, rule, {}, out);
+        gpu_bake(cuda, m, rule, {});
         ADD_FAILURE() << "no error";
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("GPU memory"), std::string::npos) << e.what();
     }
-    // Room for the BVH and about a hundred vertices: many chunks, same answer.
+    // Room for the BVH, the rule (16 bytes a direction) and about a hundred
+    // vertices (origin, normal and two words of 19 per vertex: 176 bytes):
+    // many chunks, same answer.
     const std::size_t bvh_bytes = build_bvh(m).bytes();
     CudaBackend::Limits some;
-    some.memory_bytes = bvh_bytes + 590 * 20 + 2 * 100 * 200;
+    some.memory_bytes = bvh_bytes + 590 * 16 + 100 * 176;
     cuda.set_limits(some);
-    BakeOutputs a, b;
-    cuda.bake(m, rule, {}, a);
-    EXPECT_GT(cuda.last_chunk_count(), m.vertex_count() / 200);
+    const BakeOutputs a = gpu_bake(cuda, m, rule, {});
+    EXPECT_GE(cuda.last_chunk_count(), m.vertex_count() / 101);
     cuda.set_limits({});
-    cuda.bake(m, rule, {}, b);
+    const BakeOutputs b = gpu_bake(cuda, m, rule, {});
     EXPECT_EQ(a.ao, b.ao);
 }
 
 TEST(CudaBackendGpu, MillionTriangleCityMatchesEmbree) {
     SKYBAKE_SKIP_WITHOUT_GPU();
-    const Mesh m = ao_test::generated(ProceduralKind::City, 1'000'000);
+    const Mesh m = generated(ProceduralKind::City, 1'000'000);
     const SphereRule rule = parse_rule("lebedev:110+rotate");
     BakeOptions o;
     o.store_bits = true;
-    BakeOutputs e, g;
-    make_visibility_backend("embree")->bake(m, rule, o, e);
+    const BakeOutputs e = embree_bake(m, rule, o);
     CudaBackend cuda;
-    cuda.bake(m, rule, o, g);
+    const BakeOutputs g = gpu_bake(cuda, m, rule, o);
     std::printf("1M city: %.3f s on the GPU (BVH %.2f s), %.3f s with Embree\n", g.trace_seconds, g.build_seconds,
                 e.trace_seconds);
     const Agreement a = compare_bakes(m, rule, o, g, e);
