@@ -17,11 +17,11 @@
 #include <gtest/gtest.h>
 
 #include "bake/ao_test_util.h"
+#include "bake/cuda_bake_test_util.h"
 #include "skybake/bake.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 #include "visibility/cuda/bvh.h"
-#include "bake/cuda_bake_test_util.h"
 
 using namespace skybake;
 

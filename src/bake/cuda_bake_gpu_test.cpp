@@ -34,11 +34,6 @@ BakeOutputs gpu_bake(CudaBackend& cuda, const Mesh& m, const SphereRule& rule, B
     return out;
 }
 
-BakeOutputs embree_bake(const Mesh& m, const SphereRule& rule, const BakeOptions& o) {
-    BakeOutputs out;
-    bake_shading(m, rule, *make_visibility_tracer("embree"), o, out);
-    return out;
-}
 
 void expect_same(const BakeOutputs& a, const BakeOutputs& b) {
     EXPECT_EQ(a.visibility_bits, b.visibility_bits);

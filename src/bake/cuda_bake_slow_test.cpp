@@ -18,18 +18,19 @@ using namespace skybake::visibility_test;
 
 namespace {
 
-void check(const std::string& label, const Mesh& m, const char* spec, bool tie_free_scene) {
+// The host emulation against Embree on one mesh and rule, with the bounds of
+// expect_agreement(); returns the agreement for further checks.
+Agreement check(const std::string& label, const Mesh& m, const char* spec, bool tie_free_scene,
+                BackFaces back = BackFaces::Occlude) {
     SCOPED_TRACE(label);
     const SphereRule rule = parse_rule(spec);
     BakeOptions o;
     o.store_bits = true;
-    BakeOutputs e;
-    EmbreeBackend embree;
-    bake_shading(m, rule, embree, o, e);
-    const BakeOutputs g = emulated(m, rule, o, TraceMethod::Bvh);
-    const Agreement a = compare_bakes(m, rule, o, g, e);
-    a.print((label + " " + spec + ", host emulation").c_str());
+    o.back_faces = back;
+    const Agreement a = compare_bakes(m, rule, o, emulated(m, rule, o, TraceMethod::Bvh), embree_bake(m, rule, o));
+    a.print((label + " " + spec + " " + back_faces_name(back) + ", host emulation").c_str());
     expect_agreement(a, tie_free_scene || rule.rotate_per_vertex);
+    return a;
 }
 
 } // namespace
@@ -46,48 +47,22 @@ TEST(CudaBakeSlow, SeedTableCaseMatchesEmbree) {
 }
 
 TEST(CudaBakeSlow, TheGpuTestsSettingsPassOnTheHost) {
-    // cuda_backend_gpu_test.cpp, EveryMethodMatchesEmbreeAndTheHostEmulation:
+    // cuda_bake_gpu_test.cpp, EveryMethodMatchesEmbreeAndTheHostEmulation:
     // the same scenes, rules and back-face modes, with the same bounds.
     for (const auto& [name, m] : scenes())
         for (const char* spec : gpu_test_rules())
-            for (BackFaces back : gpu_test_back_faces()) {
-                const SphereRule rule = parse_rule(spec);
-                const std::string label = name + " " + spec + " " + back_faces_name(back) + ", host emulation";
-                SCOPED_TRACE(label);
-                BakeOptions o;
-                o.store_bits = true;
-                o.back_faces = back;
-                BakeOutputs e;
-                {
-            EmbreeBackend embree;
-            bake_shading(m, rule, embree, o, e);
-        }
-                const Agreement a = compare_bakes(m, rule, o, emulated(m, rule, o, TraceMethod::Bvh), e);
-                a.print(label.c_str());
-                expect_agreement(a, tie_free(name, rule));
-            }
+            for (BackFaces back : gpu_test_back_faces())
+                check(name, m, spec, tie_free(name, parse_rule(spec)), back);
 }
 
 TEST(CudaBakeSlow, TheGpuTestsRealModelsPassOnTheHost) {
-    // cuda_backend_gpu_test.cpp, RealModelsMatchEmbree: strict bounds on both.
+    // cuda_bake_gpu_test.cpp, RealModelsMatchEmbree: strict bounds on both.
     const std::string models = SKYBAKE_ASSIMP_MODELS;
     for (const auto& [label, path, spec] :
          {std::tuple<const char*, const char*, const char*>{"engine", "/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb",
                                                             "lebedev:110+rotate"},
-          {"wuson", "/OBJ/WusonOBJ.obj", "lebedev:5810"}}) {
-        const Mesh m = load_mesh(models + path);
-        const SphereRule rule = parse_rule(spec);
-        BakeOptions o;
-        o.store_bits = true;
-        BakeOutputs e;
-        {
-            EmbreeBackend embree;
-            bake_shading(m, rule, embree, o, e);
-        }
-        const Agreement a = compare_bakes(m, rule, o, emulated(m, rule, o, TraceMethod::Bvh), e);
-        a.print((std::string(label) + " " + spec + ", host emulation").c_str());
-        expect_agreement(a, true);
-    }
+          {"wuson", "/OBJ/WusonOBJ.obj", "lebedev:5810"}})
+        check(label, load_mesh(models + path), spec, true);
 }
 
 TEST(CudaBakeSlow, TheGpuCliTestsMeshesPassOnTheHost) {
@@ -96,18 +71,8 @@ TEST(CudaBakeSlow, TheGpuCliTestsMeshesPassOnTheHost) {
     // AO within 1e-4.
     const Mesh city = generated(ProceduralKind::City, 5000), spider_mesh = spider();
     for (const auto& [label, m] : {std::pair<const char*, const Mesh&>{"city", city}, {"spider", spider_mesh}}) {
-        const SphereRule rule = parse_rule("lebedev:1202");
-        BakeOptions o;
-        o.store_bits = true;
-        BakeOutputs e;
-        {
-            EmbreeBackend embree;
-            bake_shading(m, rule, embree, o, e);
-        }
-        const BakeOutputs g = emulated(m, rule, o, TraceMethod::Bvh);
-        const Agreement a = compare_bakes(m, rule, o, g, e);
-        a.print((std::string(label) + " lebedev:1202, host emulation").c_str());
-        EXPECT_LE(double(differing_bits(g, e)), 1e-4 * double(a.rays)) << label;
+        const Agreement a = check(label, m, "lebedev:1202", true);
+        EXPECT_LE(double(a.diff), 1e-4 * double(a.rays)) << label;
         EXPECT_LE(a.mean_ao, 1e-4) << label;
     }
 }

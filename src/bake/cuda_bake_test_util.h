@@ -30,6 +30,13 @@ inline std::uint64_t differing_bits(const BakeOutputs& a, const BakeOutputs& b) 
     return d;
 }
 
+inline BakeOutputs embree_bake(const Mesh& m, const SphereRule& rule, const BakeOptions& o) {
+    BakeOutputs out;
+    EmbreeBackend embree;
+    bake_shading(m, rule, embree, o, out);
+    return out;
+}
+
 // The CUDA tracer's thread bodies run on the host (EmulatedCudaTracer), in
 // chunks of at most `chunk` vertices.
 inline BakeOutputs emulated(const Mesh& m, const SphereRule& rule, BakeOptions o, TraceMethod method,
@@ -124,8 +131,12 @@ inline Agreement compare_bakes(const Mesh& m, const SphereRule& rule, const Bake
 // The rules and back-face modes the GPU tests run on every scene
 // (cuda_backend_gpu_test.cpp); the slow tests run the same through the host
 // emulation, so a GPU run only confirms what the CPU has checked.
-inline std::vector<const char*> gpu_test_rules() { return {"lebedev:590", "lebedev:302+rotate", "lebedev:5810"}; }
-inline std::vector<BackFaces> gpu_test_back_faces() { return {BackFaces::Occlude, BackFaces::Ignore}; }
+inline std::vector<const char*> gpu_test_rules() {
+    return {"lebedev:590", "lebedev:302+rotate", "lebedev:5810"};
+}
+inline std::vector<BackFaces> gpu_test_back_faces() {
+    return {BackFaces::Occlude, BackFaces::Ignore};
+}
 
 inline bool tie_free(const std::string& scene, const SphereRule& rule) {
     return rule.rotate_per_vertex || scene == "spider" || scene == "soup";

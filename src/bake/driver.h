@@ -42,9 +42,9 @@ std::vector<glm::vec3> bake_normals(const Mesh& mesh);
 
 // A rule in single precision and in the coherent visiting order.
 struct VisitingRule {
-    std::vector<std::uint32_t> order;  // visiting position j → rule index k
-    std::vector<glm::vec3> points;     // points[j] = rule point order[j]
-    std::vector<float> weights;        // weights[j] = rule weight order[j]
+    std::vector<std::uint32_t> order; // visiting position j → rule index k
+    std::vector<glm::vec3> points;    // points[j] = rule point order[j]
+    std::vector<float> weights;       // weights[j] = rule weight order[j]
     std::uint32_t words_per_vertex = 0;
     bool rotate = false;
     std::uint64_t rotation_seed = 0;

@@ -28,9 +28,9 @@ __global__ void __launch_bounds__(kBlock) shading_kernel(ReduceParams p) {
     if (v >= p.count)
         return;
     std::uint32_t rays = 0;
-    const Shading s = shading_from_words(p.visibility + std::size_t(v) * p.words, p.points, p.weights, p.order,
-                                         p.directions, p.normals[v], p.rotate ? p.rotations[v] : glm::mat3(1.0f),
-                                         p.rotate, p.normalize, &rays);
+    const Shading s =
+        shading_from_words(p.visibility + std::size_t(v) * p.words, p.points, p.weights, p.order, p.directions,
+                           p.normals[v], p.rotate ? p.rotations[v] : glm::mat3(1.0f), p.rotate, p.normalize, &rays);
     ShadingResult r;
     r.ao = s.ao;
     r.shading = s.shading;
@@ -42,10 +42,11 @@ __global__ void __launch_bounds__(kBlock) shading_kernel(ReduceParams p) {
 
 } // namespace
 
-bool shading_cuda_available() { return true; }
+bool shading_cuda_available() {
+    return true;
+}
 
-void reduce_shading_cuda(const VisibilityRule& rule, const VisibilityChunk& chunk, bool normalize,
-                         ShadingResult* out) {
+void reduce_shading_cuda(const VisibilityRule& rule, const VisibilityChunk& chunk, bool normalize, ShadingResult* out) {
     if (!chunk.device_words)
         throw Error("the chunk has no words in GPU memory", "device_words");
     cuda::DeviceBuffer<glm::vec3> points, normals;
@@ -59,12 +60,18 @@ void reduce_shading_cuda(const VisibilityRule& rule, const VisibilityChunk& chun
     normals.upload(chunk.normals.data(), chunk.count);
     if (rule.rotate)
         rotations.upload(chunk.rotations.data(), chunk.count);
-    ReduceParams p{points.data(),  weights.data(),
-                   order.data(),   std::uint32_t(rule.points.size()),
-                   rule.words_per_vertex, rule.rotate,
-                   normalize,      chunk.count,
-                   normals.data(), rule.rotate ? rotations.data() : nullptr,
-                   chunk.device_words, results.data()};
+    ReduceParams p{points.data(),
+                   weights.data(),
+                   order.data(),
+                   std::uint32_t(rule.points.size()),
+                   rule.words_per_vertex,
+                   rule.rotate,
+                   normalize,
+                   chunk.count,
+                   normals.data(),
+                   rule.rotate ? rotations.data() : nullptr,
+                   chunk.device_words,
+                   results.data()};
     shading_kernel<<<cuda::grid_for(chunk.count, kBlock), kBlock>>>(p);
     SKYBAKE_CUDA_CHECK(cudaGetLastError());
     results.download(out, chunk.count);

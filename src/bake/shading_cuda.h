@@ -23,7 +23,6 @@ bool shading_cuda_available();
 
 // Reduces chunk.device_words into out[0 ... chunk.count). Throws
 // skybake::Error on a CUDA failure, or in a build without CUDA.
-void reduce_shading_cuda(const VisibilityRule& rule, const VisibilityChunk& chunk, bool normalize,
-                         ShadingResult* out);
+void reduce_shading_cuda(const VisibilityRule& rule, const VisibilityChunk& chunk, bool normalize, ShadingResult* out);
 
 } // namespace skybake::bake

@@ -5,7 +5,9 @@
 
 namespace skybake::bake {
 
-bool shading_cuda_available() { return false; }
+bool shading_cuda_available() {
+    return false;
+}
 
 void reduce_shading_cuda(const VisibilityRule&, const VisibilityChunk&, bool, ShadingResult*) {
     throw Error("this build has no CUDA support", "device_words");

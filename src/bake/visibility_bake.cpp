@@ -251,7 +251,6 @@ std::uint32_t spread_bits(std::uint32_t x) {
 }
 } // namespace
 
-
 std::vector<std::uint32_t> coherent_direction_order(const std::vector<glm::vec3>& points) {
     // Octahedral map (Praun & Hoppe 2003) of the unit sphere onto [-1, 1]^2,
     // then the Morton code of the 16-bit grid cell.

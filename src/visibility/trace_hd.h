@@ -17,11 +17,17 @@ namespace skybake::visibility {
 
 // [SECTION] Bits -------------------------------------------------------------------
 
-SKYBAKE_HD_INLINE std::uint32_t words_for_directions(std::uint32_t directions) { return (directions + 31u) / 32u; }
+SKYBAKE_HD_INLINE std::uint32_t words_for_directions(std::uint32_t directions) {
+    return (directions + 31u) / 32u;
+}
 
-SKYBAKE_HD_INLINE bool get_bit(const std::uint32_t* words, std::uint32_t k) { return (words[k >> 5] >> (k & 31u)) & 1u; }
+SKYBAKE_HD_INLINE bool get_bit(const std::uint32_t* words, std::uint32_t k) {
+    return (words[k >> 5] >> (k & 31u)) & 1u;
+}
 
-SKYBAKE_HD_INLINE void set_bit(std::uint32_t* words, std::uint32_t k) { words[k >> 5] |= 1u << (k & 31u); }
+SKYBAKE_HD_INLINE void set_bit(std::uint32_t* words, std::uint32_t k) {
+    words[k >> 5] |= 1u << (k & 31u);
+}
 
 // [SECTION] Directions -------------------------------------------------------------
 
@@ -40,6 +46,8 @@ SKYBAKE_HD_INLINE void vertex_direction(const glm::vec3& point, const glm::mat3&
 
 // Whether a direction needs a ray: on or above the horizon (the seed's V is 0
 // below it, so a visibility bit is never set there).
-SKYBAKE_HD_INLINE bool needs_ray(float cos_n) { return cos_n >= 0.0f; }
+SKYBAKE_HD_INLINE bool needs_ray(float cos_n) {
+    return cos_n >= 0.0f;
+}
 
 } // namespace skybake::visibility

@@ -16,41 +16,16 @@
 #include "skybake/sphere.h"
 #include "skybake/visibility.h"
 #include "visibility/cuda/emulated_tracer.h"
+#include "visibility/cuda/test_scenes.h"
 #include "visibility/trace_hd.h"
 #include "visibility/triangle_hd.h"
 
 using namespace skybake;
+using skybake::visibility_test::one_triangle_facing_down;
+using skybake::visibility_test::random_mesh;
 
 namespace {
 
-// A random triangle soup in [-1, 1]^3 plus a ground quad, with area-weighted
-// normals: plenty of partial occlusion.
-Mesh random_mesh(std::uint32_t seed, int triangles) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(-1.0f, 1.0f), s(0.1f, 0.5f);
-    Mesh m;
-    for (int t = 0; t < triangles; ++t) {
-        const glm::vec3 c(u(rng), u(rng) * 0.5f + 0.5f, u(rng));
-        for (int k = 0; k < 3; ++k)
-            m.positions.push_back(c + s(rng) * glm::vec3(u(rng), u(rng), u(rng)));
-        for (int k = 0; k < 3; ++k)
-            m.indices.push_back(std::uint32_t(3 * t + k));
-    }
-    const auto base = std::uint32_t(m.positions.size());
-    m.positions.insert(m.positions.end(), {{-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}});
-    m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
-    compute_normals(m);
-    return m;
-}
-
-Mesh one_triangle_facing_down(float height) {
-    // Counter-clockwise seen from below: front side faces -y.
-    Mesh m;
-    m.positions = {{-10, height, -10}, {10, height, -10}, {0, height, 10}};
-    m.indices = {0, 1, 2};
-    compute_normals(m);
-    return m;
-}
 
 std::vector<Ray> random_rays(std::uint32_t seed, std::size_t n) {
     std::mt19937 rng(seed);

@@ -37,6 +37,36 @@ inline Mesh random_soup(std::uint32_t seed, int triangles) {
     return m;
 }
 
+// A random triangle soup in [-1, 1]^3 plus a ground quad, with area-weighted
+// normals: plenty of partial occlusion.
+inline Mesh random_mesh(std::uint32_t seed, int triangles) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f), s(0.1f, 0.5f);
+    Mesh m;
+    for (int t = 0; t < triangles; ++t) {
+        const glm::vec3 c(u(rng), u(rng) * 0.5f + 0.5f, u(rng));
+        for (int k = 0; k < 3; ++k)
+            m.positions.push_back(c + s(rng) * glm::vec3(u(rng), u(rng), u(rng)));
+        for (int k = 0; k < 3; ++k)
+            m.indices.push_back(std::uint32_t(3 * t + k));
+    }
+    const auto base = std::uint32_t(m.positions.size());
+    m.positions.insert(m.positions.end(), {{-2, 0, -2}, {-2, 0, 2}, {2, 0, 2}, {2, 0, -2}});
+    m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    compute_normals(m);
+    return m;
+}
+
+// One large triangle at y = height, its front side facing -y (counter-clockwise
+// seen from below).
+inline Mesh one_triangle_facing_down(float height) {
+    Mesh m;
+    m.positions = {{-10, height, -10}, {10, height, -10}, {0, height, 10}};
+    m.indices = {0, 1, 2};
+    compute_normals(m);
+    return m;
+}
+
 // A procedural mesh of about `triangles` triangles, default seed.
 inline Mesh generated(ProceduralKind kind, std::uint64_t triangles) {
     ProceduralOptions p;
