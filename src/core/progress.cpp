@@ -8,12 +8,34 @@
 
 namespace skybake {
 
+namespace {
+std::mutex g_callback_mutex;
+ProgressCallback g_callback;
+
+ProgressCallback current_callback() {
+    std::lock_guard lock(g_callback_mutex);
+    return g_callback;
+}
+} // namespace
+
+ProgressCallback set_progress_callback(ProgressCallback callback) {
+    std::lock_guard lock(g_callback_mutex);
+    std::swap(g_callback, callback);
+    return callback;
+}
+
 Progress::Progress(std::string label, std::uint64_t total)
-    : label_(std::move(label)), total_(total), enabled_(!quiet() && isatty(STDERR_FILENO) == 1) {
+    : label_(std::move(label)), total_(total), callback_(current_callback()) {
+    enabled_ = callback_ ? true : (!quiet() && isatty(STDERR_FILENO) == 1);
     start_ = last_draw_ = std::chrono::steady_clock::now();
 }
 
-Progress::~Progress() { finish(); }
+Progress::~Progress() {
+    try {
+        finish();
+    } catch (...) { // a callback's exception cannot leave a destructor
+    }
+}
 
 void Progress::advance(std::uint64_t n) {
     check_interrupted();
@@ -25,7 +47,7 @@ void Progress::advance(std::uint64_t n) {
     if (!lock.owns_lock() || finished_ || now - last_draw_ < std::chrono::milliseconds(100))
         return;
     last_draw_ = now;
-    draw(done, false);
+    report(done, false);
 }
 
 void Progress::set_status(std::string status) {
@@ -39,7 +61,22 @@ void Progress::finish() {
         return;
     finished_ = true;
     if (enabled_)
-        draw(done_.load(), true);
+        report(done_.load(), true);
+}
+
+void Progress::report(std::uint64_t done, bool final) {
+    if (!callback_) {
+        draw(done, final);
+        return;
+    }
+    ProgressEvent e;
+    e.label = label_;
+    e.done = done;
+    e.total = total_;
+    e.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    e.status = status_;
+    e.finished = final;
+    callback_(e);
 }
 
 void Progress::draw(std::uint64_t done, bool final) {

@@ -1,7 +1,8 @@
 // A progress bar on stderr: the fraction done, the rate, the time elapsed and
 // the time left, and an optional status (a training loss, say). It is drawn
 // only when stderr is a terminal and quiet mode is off, and redrawn at most
-// every 100 ms. advance() is thread-safe, and throws skybake::Interrupted once
+// every 100 ms; with a callback installed (skybake/progress.h) the same
+// events go to the callback instead. advance() is thread-safe, and throws skybake::Interrupted once
 // SIGINT or SIGTERM has arrived (skybake/interrupt.h), so every loop with a
 // progress bar can be stopped cleanly.
 #pragma once
@@ -11,6 +12,8 @@
 #include <cstdint>
 #include <mutex>
 #include <string>
+
+#include "skybake/progress.h"
 
 namespace skybake {
 
@@ -29,10 +32,12 @@ public:
 
 private:
     void draw(std::uint64_t done, bool final);
+    void report(std::uint64_t done, bool final);
 
     std::string label_, status_;
     std::uint64_t total_;
     std::atomic<std::uint64_t> done_{0};
+    ProgressCallback callback_; // the one installed when the operation began, or empty
     bool enabled_;
     bool finished_ = false;
     std::mutex mutex_;
