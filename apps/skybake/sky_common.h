@@ -27,7 +27,7 @@ struct AtmosphereFlags {
             ->check(real_in(0.0, 1e12, "", End::Open))
             ->capture_default_str();
         sub.add_option("--table-rule", table_rule,
-                       "Shell density rule of the tables: seed or refined (default: the atmosphere's own)");
+                       "Shell density rule of the tables: as-published (or seed) or refined (default: the atmosphere's own)");
     }
 
     Atmosphere load(const CLI::App& sub) const {
@@ -42,12 +42,8 @@ struct AtmosphereFlags {
             return atmosphere_preset(preset.empty() ? "earth" : preset, paper_r, paper_m);
         })
                                     : load_atmosphere(file);
-        if (table_rule == "seed")
-            a.table_rule = TableRule::Seed;
-        else if (table_rule == "refined")
-            a.table_rule = TableRule::Refined;
-        else if (!table_rule.empty())
-            throw UsageError("unknown table rule '" + table_rule + "'; use seed or refined", "--table-rule");
+        if (!table_rule.empty())
+            a.table_rule = parse_flag("--table-rule", [&] { return parse_table_rule(table_rule); });
         return a;
     }
 };

@@ -30,7 +30,7 @@ void add_sky_train(CLI::App& group) {
                     "paper (4 x 4-8-4-1, 324 weights), independent:W1xW2... or shared:W1xW2...")
         ->capture_default_str();
     sub->add_option("--brightness", o->brightness,
-                    "Brightness output M: log (relative accuracy) or seed (linear, as printed)")
+                    "Brightness output M: log (relative accuracy) or linear (as printed; also: seed)")
         ->capture_default_str();
     sub->add_option("--log-range", o->log_range_decades, "Decades of N/max{N} the log brightness covers")
         ->check(real_in(0.0, 80.0, "decades", End::Open))
@@ -77,12 +77,7 @@ void add_sky_train(CLI::App& group) {
             require_cuda_device("--device cuda");
         const Atmosphere atm = o->atm.load(*sub);
         o->t.topology = parse_flag("--topology", [&] { return parse_topology(o->topology); });
-        if (o->brightness == "log")
-            o->t.brightness = BrightnessEncoding::Log;
-        else if (o->brightness == "seed")
-            o->t.brightness = BrightnessEncoding::Seed;
-        else
-            throw UsageError("unknown brightness encoding '" + o->brightness + "'; use log or seed", "--brightness");
+        o->t.brightness = parse_flag("--brightness", [&] { return parse_brightness_encoding(o->brightness); });
         o->t.log_range = o->log_range_decades * std::log(10.0);
         if (!given(*sub, "--batch"))
             o->t.batch = std::min<std::size_t>(o->t.batch, o->t.samples);

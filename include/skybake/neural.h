@@ -72,14 +72,19 @@ NeuralTopology parse_topology(std::string_view text, const std::string& where = 
 // 0.05 + 0.9 · value; the seed's vertex program decodes all four outputs with
 // (x − 0.05)/0.9 and treats x < 0.05 as 0 (section VI, "final transformation").
 //
-// Brightness "seed" is the seed's linear M. Brightness "log" replaces it with
+// Brightness "linear" is the paper's linear M. Brightness "log" replaces it with
 //   M = 0.05 + 0.9 · max(0, 1 + ln(N / max{N}) / log_range),
 // so that a fixed error in M is a fixed *relative* error in N (the sky's
 // brightness spans many decades between noon and twilight).
 enum class BrightnessEncoding : int {
-    Seed = 0, // linear, as printed in the seed
+    Linear = 0, // "linear" (files may say "seed"): M = 0.05 + 0.9 · N / max{N}, as Pietras & Rudnicki print it
     Log = 1,  // logarithmic over log_range nats below max{N}
 };
+
+// "linear" or "log"; parse_brightness_encoding() also takes the older "seed"
+// for Linear, and throws skybake::Error naming `where` otherwise.
+const char* brightness_encoding_name(BrightnessEncoding encoding);
+BrightnessEncoding parse_brightness_encoding(const std::string& text, const std::string& where = "brightness");
 
 struct NeuralEncoding {
     BrightnessEncoding brightness = BrightnessEncoding::Log;
@@ -270,11 +275,11 @@ NeuralErrorReport measure_neural_sky_error(const NeuralSky& net, const NeuralErr
 //
 // The seed's views (section VII): sea level, higher and higher, low sun, very
 // high. Camera views; the atmosphere is the network's.
-struct SeedView {
+struct PublishedView {
     std::string name;
     SkyRenderSettings settings;
 };
-std::vector<SeedView> seed_views(int width, int height);
+std::vector<PublishedView> published_views(int width, int height);
 
 // As render_sky, with the sky and the in-scattered light in front of the ground
 // from the network (the seed's section III), and the ground and the sun disc

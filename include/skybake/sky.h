@@ -52,8 +52,11 @@ enum class PhaseFunction : int {
     Rayleigh = 1,          // 3/(16π) (1 + cos²)
     HenyeyGreenstein = 2,  // (1 − g²) / (4π (1 + g² − 2g cos)^1.5)
     CornetteShanks = 3,    // 3(1 − g²)(1 + cos²) / (8π (2 + g²)(1 + g² − 2g cos)^1.5)
-    SeedMie = 4,           // as printed in seed 000: (1 − g²) / (16π (1 + g² − 2g cos)^1.5);
-                           // this is Henyey–Greenstein / 4 and integrates to 1/4, not 1
+    // "pietras-rudnicki-mie": the Mie phase as printed by Pietras & Rudnicki
+    // (the neural sky paper, seed 000): (1 − g²) / (16π (1 + g² − 2g cos)^1.5).
+    // This is Henyey–Greenstein / 4 and integrates to 1/4, not 1. Files may
+    // still spell it "seed-mie".
+    PietrasRudnickiMie = 4,
 };
 
 enum class DensityProfile : int {
@@ -71,15 +74,21 @@ struct AtmosphereComponent {
     glm::dvec3 scattering_per_km{0.0};     // at relative density 1, per channel, ≥ 0
     glm::dvec3 extinction_per_km{0.0};     // at relative density 1, per channel, ≥ scattering
     PhaseFunction phase = PhaseFunction::Rayleigh;
-    double phase_g = 0.0;                  // asymmetry parameter in (−1, 1) for HG, CS and SeedMie
+    double phase_g = 0.0;                  // asymmetry parameter in (−1, 1) for HG, CS and PietrasRudnickiMie
 };
 
 // How each shell of the optical-length table weighs its length (see docs/sky.md).
 enum class TableRule : int {
-    Seed = 0,    // seed 000 as printed: S = ρ_i s_i, the density at the shell's outer boundary
-    Refined = 1, // each shell cut into sub-shells at most H/16 thick, each weighted by its
-                 // mean density (exact for vertical rays); same rows, same recursion
+    AsPublished = 0, // "as-published" (files may say "seed"): Pietras & Rudnicki's rule as printed,
+                     // S = ρ_i s_i, the density at the shell's outer boundary
+    Refined = 1,     // each shell cut into sub-shells at most H/16 thick, each weighted by its
+                     // mean density (exact for vertical rays); same rows, same recursion
 };
+
+// "as-published" or "refined"; parse_table_rule() also takes the older
+// "seed" for AsPublished, and throws skybake::Error naming `where` otherwise.
+const char* table_rule_name(TableRule rule);
+TableRule parse_table_rule(const std::string& text, const std::string& where = "table_rule");
 
 struct Atmosphere {
     std::string name;
@@ -95,7 +104,7 @@ struct Atmosphere {
     glm::dvec3 sun_irradiance{1.0};
     double sun_angular_radius_rad = 0.004675;
     glm::dvec3 ground_albedo{0.1};   // Lambertian ground reflectance C, per channel, in [0, 1]
-    TableRule table_rule = TableRule::Seed;
+    TableRule table_rule = TableRule::AsPublished;
 
     // Throws skybake::Error naming the first bad field.
     void validate() const;

@@ -68,7 +68,7 @@ NeuralErrorReport measure_neural_sky_error(const NeuralSky& net, const NeuralErr
         if (!o.views_dir.empty())
             std::filesystem::create_directories(o.views_dir);
         double sum = 0.0, mn = INFINITY;
-        for (const SeedView& v : seed_views(o.view_width, o.view_height)) {
+        for (const PublishedView& v : published_views(o.view_width, o.view_height)) {
             const Image a = render_sky(model, v.settings);
             const Image b = render_neural_sky(net, model, v.settings);
             ToneMap tm;

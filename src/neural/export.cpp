@@ -162,7 +162,7 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const s
         o << fmt::format("    if (!(m > {})) return {}({});\n", zero, d.vec3, zero);
     else
         o << fmt::format("    if (!(m > {})) {{ rgb[0] = rgb[1] = rgb[2] = {}; return; }}\n", zero, zero);
-    if (net.encoding.brightness == BrightnessEncoding::Seed)
+    if (net.encoding.brightness == BrightnessEncoding::Linear)
         o << fmt::format("    {}float n = m * {};\n", cst, lit(float(net.encoding.max_n), d));
     else
         o << fmt::format("    {}float n = {} * {}({} * (m - {}));\n", cst, lit(float(net.encoding.max_n), d), d.exp,

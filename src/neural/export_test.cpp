@@ -100,7 +100,7 @@ TEST(NeuralExport, CAndCudaAgreeWithTheLibrary) {
         GTEST_SKIP() << "no system C/C++ compiler";
     const std::vector<SkySample> s = draw_sky_samples(2000, 77);
     for (const char* top : {"paper", "shared:16x8"}) {
-        for (BrightnessEncoding b : {BrightnessEncoding::Log, BrightnessEncoding::Seed}) {
+        for (BrightnessEncoding b : {BrightnessEncoding::Log, BrightnessEncoding::Linear}) {
             const NeuralSky net = make_net(top, b);
             std::vector<glm::vec3> batch(s.size());
             evaluate_neural_sky(net, s, batch);
@@ -201,7 +201,7 @@ TEST(NeuralExport, ShaderLiteralsEqualTheCExports) {
     // HLSL only compile. Their numbers must be the C export's, bit for bit and
     // in the same order, so a rounding or a dropped weight in one dialect fails.
     for (const char* top : {"paper", "independent:16x16", "shared:16x8"})
-        for (BrightnessEncoding b : {BrightnessEncoding::Log, BrightnessEncoding::Seed}) {
+        for (BrightnessEncoding b : {BrightnessEncoding::Log, BrightnessEncoding::Linear}) {
             const NeuralSky net = make_net(top, b);
             const std::vector<float> c = float_literals(export_neural_sky(net, ExportLanguage::C));
             ASSERT_GE(c.size(), std::size_t(net.topology.weight_count())) << top;

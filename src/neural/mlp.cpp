@@ -67,7 +67,7 @@ MlpHD make_mlp_hd(const NeuralSky& net) {
     for (int l = 0; l < m.layers; ++l)
         m.width[l + 1] = lay.layers[std::size_t(l)].out;
     m.subnet_params = lay.subnet_params;
-    m.brightness = net.encoding.brightness == BrightnessEncoding::Seed ? kBrightnessSeed : kBrightnessLog;
+    m.brightness = net.encoding.brightness == BrightnessEncoding::Linear ? kBrightnessLinear : kBrightnessLog;
     m.max_n = float(net.encoding.max_n);
     m.log_range = float(net.encoding.log_range);
     return m;
@@ -211,7 +211,7 @@ void encode_sky_radiance(const NeuralEncoding& e, const glm::vec3& c, float enc[
     enc[1] = kEncodeOffset + kEncodeScale * std::max(0.0f, c.y) / n;
     enc[2] = kEncodeOffset + kEncodeScale * std::max(0.0f, c.z) / n;
     double m;
-    if (e.brightness == BrightnessEncoding::Seed)
+    if (e.brightness == BrightnessEncoding::Linear)
         m = double(n) / e.max_n;
     else
         m = std::max(0.0, 1.0 + std::log(double(n) / e.max_n) / e.log_range);
@@ -220,7 +220,7 @@ void encode_sky_radiance(const NeuralEncoding& e, const glm::vec3& c, float enc[
 
 glm::vec3 decode_sky_radiance(const NeuralEncoding& e, const float enc[4]) {
     MlpHD m;
-    m.brightness = e.brightness == BrightnessEncoding::Seed ? kBrightnessSeed : kBrightnessLog;
+    m.brightness = e.brightness == BrightnessEncoding::Linear ? kBrightnessLinear : kBrightnessLog;
     m.max_n = float(e.max_n);
     m.log_range = float(e.log_range);
     return decode_sky(m, enc);

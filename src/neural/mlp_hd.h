@@ -29,7 +29,7 @@ constexpr float kEncodeScale = 0.9f;
 // f(x) = 1/(1 + 2^(2x)) = σ(−kSlope x) with kSlope = 2 ln 2.
 constexpr float kSlope = 1.38629436111989f;
 
-enum : int { kBrightnessSeed = 0, kBrightnessLog = 1 };
+enum : int { kBrightnessLinear = 0, kBrightnessLog = 1 };
 
 struct MlpHD {
     const float* weights = nullptr; // subnets * subnet_params floats
@@ -88,7 +88,7 @@ SKYBAKE_HD_INLINE glm::vec3 decode_sky(const MlpHD& m, const float enc[kOutputs]
     const float mm = (enc[3] - kEncodeOffset) * (1.0f / kEncodeScale);
     if (!(mm > 0.0f))
         return glm::vec3(0.0f); // night
-    const float n = m.brightness == kBrightnessSeed ? mm * m.max_n : m.max_n * expf(m.log_range * (mm - 1.0f));
+    const float n = m.brightness == kBrightnessLinear ? mm * m.max_n : m.max_n * expf(m.log_range * (mm - 1.0f));
     return glm::vec3(decode_unit(enc[0]) * n, decode_unit(enc[1]) * n, decode_unit(enc[2]) * n);
 }
 

@@ -9,6 +9,7 @@
 
 #include "neural/internal.h"
 #include "skybake/error.h"
+#include "skybake/names.h"
 #include "skybake/files.h"
 
 namespace skybake {
@@ -108,7 +109,7 @@ std::string neural_sky_to_json(const NeuralSky& net) {
                      {"outputs", "R/N, G/N, B/N, M (each as 0.05 + 0.9 value)"},
                      {"activation", "1/(1+2^(2x))"},
                      {"weight_count", net.topology.weight_count()}};
-    j["encoding"] = {{"brightness", net.encoding.brightness == BrightnessEncoding::Seed ? "seed" : "log"},
+    j["encoding"] = {{"brightness", brightness_encoding_name(net.encoding.brightness)},
                      {"max_n", net.encoding.max_n},
                      {"log_range", net.encoding.log_range}};
     json subnets = json::array();
@@ -196,12 +197,9 @@ NeuralSky neural_sky_from_json(std::string_view text, const std::string& where) 
 
         const json& enc = field(j, "encoding", where);
         const json& b = field(enc, "brightness", where + ": encoding");
-        if (b == "seed")
-            net.encoding.brightness = BrightnessEncoding::Seed;
-        else if (b == "log")
-            net.encoding.brightness = BrightnessEncoding::Log;
-        else
-            throw Error("encoding.brightness must be \"seed\" or \"log\"", where);
+        if (!b.is_string())
+            throw Error("encoding.brightness must be \"linear\" or \"log\"", where);
+        net.encoding.brightness = parse_brightness_encoding(b.get<std::string>(), where + ": encoding.brightness");
         net.encoding.max_n = number(enc, "max_n", where + ": encoding");
         net.encoding.log_range = number(enc, "log_range", where + ": encoding");
 
@@ -271,5 +269,20 @@ void save_neural_sky(const std::filesystem::path& path, const NeuralSky& net) {
 }
 
 SkyModel neural_reference_model(const NeuralSky& net) { return SkyModel(net.atmosphere, net.sky_options); }
+
+namespace {
+constexpr NamedValue<BrightnessEncoding> kBrightnessNames[] = {
+    {BrightnessEncoding::Linear, "linear", "the paper's"},
+    {BrightnessEncoding::Log, "log", "a fixed relative error over many decades"},
+};
+} // namespace
+
+const char* brightness_encoding_name(BrightnessEncoding encoding) { return name_of(kBrightnessNames, encoding); }
+
+BrightnessEncoding parse_brightness_encoding(const std::string& text, const std::string& where) {
+    if (text == "seed") // the name files and scripts used before
+        return BrightnessEncoding::Linear;
+    return parse_name(kBrightnessNames, text, "brightness encoding", where);
+}
 
 } // namespace skybake

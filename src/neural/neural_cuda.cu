@@ -74,7 +74,7 @@ __device__ __forceinline__ glm::vec3 decode_fast(const MlpHD& m, const float enc
     const float mm = (enc[3] - kEncodeOffset) * (1.0f / kEncodeScale);
     if (!(mm > 0.0f))
         return glm::vec3(0.0f);
-    const float n = m.brightness == kBrightnessSeed ? mm * m.max_n : m.max_n * __expf(m.log_range * (mm - 1.0f));
+    const float n = m.brightness == kBrightnessLinear ? mm * m.max_n : m.max_n * __expf(m.log_range * (mm - 1.0f));
     return glm::vec3(decode_unit(enc[0]) * n, decode_unit(enc[1]) * n, decode_unit(enc[2]) * n);
 }
 

@@ -207,7 +207,7 @@ TEST(NeuralGradient, NormalEquationsAreJacobianProducts) {
 
 TEST(NeuralInference, BatchScalarAndDoubleAgree) {
     for (const char* name : {"paper", "independent:16x16", "shared:12x8"}) {
-        for (BrightnessEncoding enc : {BrightnessEncoding::Log, BrightnessEncoding::Seed}) {
+        for (BrightnessEncoding enc : {BrightnessEncoding::Log, BrightnessEncoding::Linear}) {
             NeuralSky net = tiny_net(parse_topology(name), 21);
             net.encoding.brightness = enc;
             const std::vector<SkySample> s = draw_sky_samples(3000, 9);
@@ -235,7 +235,7 @@ TEST(NeuralInference, BatchScalarAndDoubleAgree) {
 }
 
 TEST(NeuralEncoding, RoundTripsAndNight) {
-    for (BrightnessEncoding b : {BrightnessEncoding::Log, BrightnessEncoding::Seed}) {
+    for (BrightnessEncoding b : {BrightnessEncoding::Log, BrightnessEncoding::Linear}) {
         NeuralEncoding e;
         e.brightness = b;
         e.max_n = 0.2;
@@ -270,7 +270,7 @@ TEST(NeuralEncoding, RoundTripsAndNight) {
 TEST(NeuralEncoding, DecodeRuleBelowTheOffsetIsZero) {
     // Decoding: c = (x − 0.05)/0.9, and 0 for x ≤ 0.05; a brightness output at
     // or below 0.05 is night, whatever the colour outputs say.
-    for (BrightnessEncoding b : {BrightnessEncoding::Log, BrightnessEncoding::Seed}) {
+    for (BrightnessEncoding b : {BrightnessEncoding::Log, BrightnessEncoding::Linear}) {
         NeuralEncoding e;
         e.brightness = b;
         e.max_n = 0.5;
@@ -291,7 +291,7 @@ TEST(NeuralEncoding, DecodeRuleBelowTheOffsetIsZero) {
     }
     // Seed brightness is linear in M; log brightness is max_n · exp(range (M − 1)).
     NeuralEncoding seed;
-    seed.brightness = BrightnessEncoding::Seed;
+    seed.brightness = BrightnessEncoding::Linear;
     seed.max_n = 0.5;
     const float half[4] = {0.95f, 0.95f, 0.95f, 0.5f};
     EXPECT_NEAR(decode_sky_radiance(seed, half).x, 0.5f * 0.5f, 1e-6f);
@@ -444,4 +444,19 @@ TEST(NeuralChart, DrawsAxesAndBothCurves) {
     EXPECT_GT(blue, 200);
     EXPECT_GT(red, 200);
     EXPECT_GT(black, 500); // axes, ticks and labels
+}
+
+TEST(NeuralNames, BrightnessEncodingsHaveOneTableAndTheOlderSpelling) {
+    EXPECT_STREQ(brightness_encoding_name(BrightnessEncoding::Linear), "linear");
+    EXPECT_STREQ(brightness_encoding_name(BrightnessEncoding::Log), "log");
+    EXPECT_EQ(parse_brightness_encoding("linear"), BrightnessEncoding::Linear);
+    EXPECT_EQ(parse_brightness_encoding("seed"), BrightnessEncoding::Linear); // written before the rename
+    EXPECT_EQ(parse_brightness_encoding("log"), BrightnessEncoding::Log);
+    try {
+        parse_brightness_encoding("sqrt");
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.where(), "brightness");
+        EXPECT_NE(e.message().find("linear"), std::string::npos) << e.message();
+    }
 }

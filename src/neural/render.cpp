@@ -28,9 +28,9 @@ Image render_neural_sky(const NeuralSky& net, const SkyModel& model, const SkyRe
     return sky::render_pixels(p, [&](const glm::vec3& d) { return shade_ray_neural(p, hd, d); });
 }
 
-std::vector<SeedView> seed_views(int width, int height) {
+std::vector<PublishedView> published_views(int width, int height) {
     auto view = [&](const char* name, double alt, double sun_el, double sun_az, double pitch, double yaw) {
-        SeedView v;
+        PublishedView v;
         v.name = name;
         v.settings.altitude_km = alt;
         v.settings.sun_elevation_deg = sun_el;

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "skybake/error.h"
+#include "skybake/names.h"
 #include "skybake/files.h"
 #include "skybake/sky.h"
 #include "sky/sky_hd.h"
@@ -23,32 +24,40 @@ using nlohmann::json;
 
 bool finite3(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-const char* phase_name(PhaseFunction p) {
-    switch (p) {
-    case PhaseFunction::None:
-        return "none";
-    case PhaseFunction::Rayleigh:
-        return "rayleigh";
-    case PhaseFunction::HenyeyGreenstein:
-        return "henyey-greenstein";
-    case PhaseFunction::CornetteShanks:
-        return "cornette-shanks";
-    case PhaseFunction::SeedMie:
-        return "seed-mie";
-    }
-    return "none";
-}
+constexpr NamedValue<PhaseFunction> kPhaseNames[] = {
+    {PhaseFunction::None, "none"},
+    {PhaseFunction::Rayleigh, "rayleigh"},
+    {PhaseFunction::HenyeyGreenstein, "henyey-greenstein"},
+    {PhaseFunction::CornetteShanks, "cornette-shanks"},
+    {PhaseFunction::PietrasRudnickiMie, "pietras-rudnicki-mie"},
+};
+
+const char* phase_name(PhaseFunction p) { return name_of(kPhaseNames, p); }
 
 PhaseFunction parse_phase(const std::string& s, const std::string& where) {
-    for (PhaseFunction p : {PhaseFunction::None, PhaseFunction::Rayleigh, PhaseFunction::HenyeyGreenstein,
-                            PhaseFunction::CornetteShanks, PhaseFunction::SeedMie})
-        if (s == phase_name(p))
-            return p;
-    throw Error(fmt::format("unknown phase function '{}'; use none, rayleigh, henyey-greenstein, cornette-shanks "
-                            "or seed-mie",
-                            s),
-                where);
+    if (s == "seed-mie") // the name files used before
+        return PhaseFunction::PietrasRudnickiMie;
+    return parse_name(kPhaseNames, s, "phase function", where);
 }
+
+} // namespace
+
+namespace {
+constexpr NamedValue<TableRule> kTableRuleNames[] = {
+    {TableRule::AsPublished, "as-published", "the paper's density at the shell boundary"},
+    {TableRule::Refined, "refined", "sub-shells weighted by their mean density"},
+};
+} // namespace
+
+const char* table_rule_name(TableRule rule) { return name_of(kTableRuleNames, rule); }
+
+TableRule parse_table_rule(const std::string& text, const std::string& where) {
+    if (text == "seed") // the name files and scripts used before
+        return TableRule::AsPublished;
+    return parse_name(kTableRuleNames, text, "table rule", where);
+}
+
+namespace {
 
 const char* profile_name(DensityProfile p) {
     switch (p) {
@@ -150,7 +159,7 @@ void Atmosphere::validate() const {
         if (c.phase == PhaseFunction::None && (c.scattering_per_km != glm::dvec3(0.0)))
             throw Error("a component that scatters needs a phase function", w);
         if ((c.phase == PhaseFunction::HenyeyGreenstein || c.phase == PhaseFunction::CornetteShanks ||
-             c.phase == PhaseFunction::SeedMie) &&
+             c.phase == PhaseFunction::PietrasRudnickiMie) &&
             !(std::isfinite(c.phase_g) && std::abs(c.phase_g) < 1.0))
             throw Error("phase g must be in (-1, 1)", w);
     }
@@ -218,7 +227,7 @@ Atmosphere atmosphere_preset(std::string_view name, double paper_r, double paper
         const glm::dvec3 br = glm::dvec3(q475, q546, 1.0) / paper_r;
         const glm::dvec3 bm = glm::dvec3(q475) / paper_m;
         a.components.push_back(exponential("rayleigh", 8.3, br, br, PhaseFunction::Rayleigh, 0.0));
-        a.components.push_back(exponential("mie", 1.6, bm, bm, PhaseFunction::SeedMie, 0.76));
+        a.components.push_back(exponential("mie", 1.6, bm, bm, PhaseFunction::PietrasRudnickiMie, 0.76));
         a.ground_albedo = glm::dvec3(0.5); // the seed's grey surface, C = 0.5
         a.sun_elevation_deg = 30.0;
         return a;
@@ -234,7 +243,7 @@ std::string atmosphere_to_json(const Atmosphere& a) {
     j["length_unit"] = "km";
     j["planet_radius_km"] = a.planet_radius_km;
     j["top_radius_km"] = a.top_radius_km;
-    j["table_rule"] = a.table_rule == TableRule::Seed ? "seed" : "refined";
+    j["table_rule"] = table_rule_name(a.table_rule);
     json comps = json::array();
     for (const AtmosphereComponent& c : a.components) {
         json cj;
@@ -253,7 +262,7 @@ std::string atmosphere_to_json(const Atmosphere& a) {
         json ph;
         ph["type"] = phase_name(c.phase);
         if (c.phase == PhaseFunction::HenyeyGreenstein || c.phase == PhaseFunction::CornetteShanks ||
-            c.phase == PhaseFunction::SeedMie)
+            c.phase == PhaseFunction::PietrasRudnickiMie)
             ph["g"] = c.phase_g;
         cj["phase"] = ph;
         comps.push_back(cj);
@@ -283,14 +292,8 @@ Atmosphere atmosphere_from_json(std::string_view text, const std::string& where)
         throw Error("length_unit must be \"km\"", where);
     a.planet_radius_km = get<double>(j, "planet_radius_km", where);
     a.top_radius_km = get<double>(j, "top_radius_km", where);
-    const std::string seed_rule = "seed";
-    const std::string rule = get<std::string>(j, "table_rule", where, &seed_rule);
-    if (rule == "seed")
-        a.table_rule = TableRule::Seed;
-    else if (rule == "refined")
-        a.table_rule = TableRule::Refined;
-    else
-        throw Error(fmt::format("unknown table_rule '{}'; use seed or refined", rule), where);
+    const std::string published = table_rule_name(TableRule::AsPublished);
+    a.table_rule = parse_table_rule(get<std::string>(j, "table_rule", where, &published), where);
     if (!j.contains("components") || !j["components"].is_array())
         throw Error("missing array 'components'", where);
     for (std::size_t i = 0; i < j["components"].size(); ++i) {
@@ -366,7 +369,7 @@ double phase_function(PhaseFunction phase, double g, double mu) {
         const double d = 1.0 + g * g - 2.0 * g * mu;
         return 3.0 * (1.0 - g * g) * (1.0 + mu * mu) / (8.0 * pi * (2.0 + g * g) * d * std::sqrt(d));
     }
-    case PhaseFunction::SeedMie: {
+    case PhaseFunction::PietrasRudnickiMie: {
         const double d = 1.0 + g * g - 2.0 * g * mu;
         return (1.0 - g * g) / (16.0 * pi * d * std::sqrt(d));
     }

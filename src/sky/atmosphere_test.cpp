@@ -102,3 +102,28 @@ TEST(AtmosphereValidate, ANumberBeyondDoubleIsAnErrorNotACrash) {
         EXPECT_EQ(e.where(), "big.json");
     }
 }
+
+TEST(AtmosphereNames, PublishedVariantsHaveTheirNamesAndTheOlderSpellingsStillLoad) {
+    Atmosphere a = atmosphere_preset("earth");
+    a.components[1].phase = PhaseFunction::PietrasRudnickiMie;
+    a.components[1].phase_g = 0.7;
+    a.table_rule = TableRule::AsPublished;
+    const std::string text = atmosphere_to_json(a);
+    EXPECT_NE(text.find("\"pietras-rudnicki-mie\""), std::string::npos) << text;
+    EXPECT_NE(text.find("\"as-published\""), std::string::npos) << text;
+    // A file written before the rename: the same atmosphere.
+    std::string old = text;
+    old.replace(old.find("\"pietras-rudnicki-mie\""), 22, "\"seed-mie\"");
+    old.replace(old.find("\"as-published\""), 14, "\"seed\"");
+    const Atmosphere b = atmosphere_from_json(old, "old.json");
+    EXPECT_EQ(b.components[1].phase, PhaseFunction::PietrasRudnickiMie);
+    EXPECT_EQ(b.table_rule, TableRule::AsPublished);
+    EXPECT_EQ(parse_table_rule("refined"), TableRule::Refined);
+    try {
+        parse_table_rule("coarse", "--table-rule");
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.where(), "--table-rule");
+        EXPECT_NE(e.message().find("as-published"), std::string::npos) << e.message();
+    }
+}

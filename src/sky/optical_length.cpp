@@ -67,7 +67,7 @@ double mean_density(const AtmosphereComponent& comp, double h_in, double h_out) 
 // Sub-shells per shell: one for the seed's rule; for the refined rule enough
 // that none is thicker than a sixteenth of the profile's length scale.
 int sub_shells(const AtmosphereComponent& comp, TableRule rule, double h_in, double h_out) {
-    if (rule == TableRule::Seed || h_out <= h_in)
+    if (rule == TableRule::AsPublished || h_out <= h_in)
         return 1;
     double scale = comp.profile == DensityProfile::Exponential ? comp.scale_height_km
                    : comp.profile == DensityProfile::Tent      ? comp.tent_half_width_km
@@ -98,7 +98,7 @@ std::vector<SubShell> sub_shells_of(const AtmosphereComponent& comp, TableRule r
     std::vector<SubShell> out;
     if (!(h_out > h_in))
         return out;
-    if (rule == TableRule::Seed) {
+    if (rule == TableRule::AsPublished) {
         out.push_back({R0 + h_in, R0 + h_out, relative_density(comp, h_out)});
         return out;
     }

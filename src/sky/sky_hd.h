@@ -22,7 +22,7 @@ constexpr int kMaxComponents = 4;
 constexpr float kPi = 3.14159265358979f;
 
 // Values of skybake::PhaseFunction / DensityProfile, kept as ints here.
-enum : int { kPhaseNone = 0, kPhaseRayleigh = 1, kPhaseHG = 2, kPhaseCornetteShanks = 3, kPhaseSeedMie = 4 };
+enum : int { kPhaseNone = 0, kPhaseRayleigh = 1, kPhaseHG = 2, kPhaseCornetteShanks = 3, kPhasePietrasRudnickiMie = 4 };
 enum : int { kProfileExponential = 0, kProfileTent = 1, kProfileConstant = 2 };
 // Height coordinate of a table's rows.
 enum : int { kAxisDensity = 0, kAxisAltitude = 1 };
@@ -68,7 +68,7 @@ SKYBAKE_HD_INLINE float phase_value(int kind, float g, float mu) {
         const float d = 1.0f + g * g - 2.0f * g * mu;
         return 3.0f * (1.0f - g * g) * (1.0f + mu * mu) / (8.0f * kPi * (2.0f + g * g) * d * sqrtf(d));
     }
-    case kPhaseSeedMie: {
+    case kPhasePietrasRudnickiMie: {
         const float d = 1.0f + g * g - 2.0f * g * mu;
         return (1.0f - g * g) / (16.0f * kPi * d * sqrtf(d));
     }

@@ -33,7 +33,7 @@ double forward_phase(PhaseFunction p, double g) {
     case PhaseFunction::Rayleigh: return 3.0 / (8.0 * M_PI);
     case PhaseFunction::HenyeyGreenstein: return (1.0 + g) / (4.0 * M_PI * (1.0 - g) * (1.0 - g));
     case PhaseFunction::CornetteShanks: return 6.0 * (1.0 + g) / (8.0 * M_PI * (2.0 + g * g) * (1.0 - g) * (1.0 - g));
-    case PhaseFunction::SeedMie: return (1.0 + g) / (16.0 * M_PI * (1.0 - g) * (1.0 - g));
+    case PhaseFunction::PietrasRudnickiMie: return (1.0 + g) / (16.0 * M_PI * (1.0 - g) * (1.0 - g));
     }
     return -1.0;
 }
@@ -74,7 +74,7 @@ TEST(PhaseFunctions, NormalisedOverTheSphere) {
         EXPECT_NEAR(integral(PhaseFunction::HenyeyGreenstein, g, 0), 1.0, 1e-4) << g;
         EXPECT_NEAR(integral(PhaseFunction::HenyeyGreenstein, g, 1), g, 1e-4) << g; // mean cosine
         EXPECT_NEAR(integral(PhaseFunction::CornetteShanks, g, 0), 1.0, 1e-4) << g;
-        EXPECT_NEAR(integral(PhaseFunction::SeedMie, g, 0), 0.25, 1e-4) << g;
+        EXPECT_NEAR(integral(PhaseFunction::PietrasRudnickiMie, g, 0), 0.25, 1e-4) << g;
     }
 }
 
@@ -97,9 +97,9 @@ TEST(PhaseFunctions, PinnedToTheirFormulasForwardSidewaysAndBack) {
         EXPECT_NEAR(phase_function(PhaseFunction::CornetteShanks, g, -1.0), 2 * cs * hg_b, 1e-12 * hg_b) << g;
         EXPECT_NEAR(phase_function(PhaseFunction::CornetteShanks, g, 0.0), cs * hg_s, 1e-12 * hg_s) << g;
         // The seed's printed Mie: HG / 4.
-        EXPECT_NEAR(phase_function(PhaseFunction::SeedMie, g, 1.0), hg_f / 4, 1e-12 * hg_f) << g;
-        EXPECT_NEAR(phase_function(PhaseFunction::SeedMie, g, -1.0), hg_b / 4, 1e-12 * hg_f) << g;
-        EXPECT_NEAR(phase_function(PhaseFunction::SeedMie, g, 0.0), hg_s / 4, 1e-12 * hg_f) << g;
+        EXPECT_NEAR(phase_function(PhaseFunction::PietrasRudnickiMie, g, 1.0), hg_f / 4, 1e-12 * hg_f) << g;
+        EXPECT_NEAR(phase_function(PhaseFunction::PietrasRudnickiMie, g, -1.0), hg_b / 4, 1e-12 * hg_f) << g;
+        EXPECT_NEAR(phase_function(PhaseFunction::PietrasRudnickiMie, g, 0.0), hg_s / 4, 1e-12 * hg_f) << g;
         EXPECT_EQ(phase_function(PhaseFunction::None, g, 0.5), 0.0);
     }
     // Forward scattering dominates for g > 0: p(1)/p(−1) = ((1 + g)/(1 − g))³.
