@@ -106,7 +106,7 @@ void run(const AoOptions& o, const CLI::App& sub) {
 
     BakeOptions b;
     b.max_distance = float(o.max_distance);
-    b.ray_offset = o.offset == "auto" ? -1.0f : float(std::stod(o.offset)); // validated: auto or a number ≥ 0
+    b.ray_offset = o.offset == "auto" ? 0.0f : float(std::stod(o.offset)); // validated: auto or a number ≥ 0
     b.back_faces = back_faces;
     b.normalize = o.normalize;
     b.store_bits = !o.bits.empty();
@@ -198,8 +198,8 @@ void add_ao_bake(CLI::App& group) {
                     "Ignore occluders further than this, in mesh units (default: unlimited)")
         ->check(real_in(0.0, 1e30, "mesh units", End::Open)); // stored as a float
     sub->add_option("--offset", o->offset,
-                    "Move ray origins this far along the normal, in mesh units; auto: 1e-4 x the bounding-box "
-                    "diagonal")
+                    "Move ray origins this much further along the normal, in mesh units; auto (= 0): only the "
+                    "step past rounding, 2^-15 of the vertex's coordinates")
         ->check(auto_or_real_in(0.0, 1e30, "mesh units"))
         ->capture_default_str();
     sub->add_option("--back-faces", o->back_faces,

@@ -57,26 +57,27 @@ namespace skybake {
 // put whole orbits there for axis-aligned normals; the midpoint value of the
 // step keeps A unbiased) and 0 below. Directions below the horizon need no ray.
 // A ray starts at
-//     origin = p + offset·(n + u),   t in (0, max_distance],
-// so that it does not hit the triangles around p itself. u is zero for most
-// vertices; for a vertex on a mesh border or where two surfaces meet (its
-// triangles' area-weighted mean centroid is off the vertex) it is the unit
-// tangent towards that centroid: a floor vertex at the foot of a wall, or the
-// bottom edge of a box standing on the ground, then starts its rays just off
-// the other surface instead of on it.
-
-// The default offset is this fraction of the mesh's bounding-box diagonal:
-// scale-aware, so a bake does not change when the mesh is scaled or moved.
-inline constexpr float kDefaultRayOffsetScale = 1e-4f;
+//     origin = p + (offset + ε)·(n + u),   t in (0, max_distance],
+// where ε = 2^-15 · max(|p|∞, size of p's triangles), 256 to 512 units in
+// the last place of a float (after Wächter & Binder, Ray Tracing Gems ch. 6, 2019):
+// enough to clear the rounding of the ray–triangle tests at the vertex's own
+// triangles, far less than any real gap between surfaces, and independent of
+// the scene's size. The user offset is 0 by default. u is zero for most vertices; for a vertex
+// on a mesh border or where two surfaces meet (its triangles' area-weighted
+// mean centroid is off the vertex) it is the unit tangent towards that
+// centroid: a floor vertex at the foot of a wall, or the bottom edge of a box
+// standing on the ground, then starts its rays on its own side of the other
+// surface instead of on it.
 
 struct BakeOptions {
     // Occluders further than this from the ray origin are ignored, in mesh units.
     // Infinity (the default) means unlimited; must be > 0.
     float max_distance = std::numeric_limits<float>::infinity();
     // Distance the ray origin is moved along the vertex normal (and, on borders
-    // and creases, towards the vertex's triangles), in mesh units.
-    // Negative (the default): kDefaultRayOffsetScale × bounding-box diagonal.
-    float ray_offset = -1.0f;
+    // and creases, towards the vertex's triangles), in mesh units, on top of
+    // the step past rounding that every origin gets. ≥ 0; 0 by default. A
+    // negative value means 0 (the former "scene-relative default").
+    float ray_offset = 0.0f;
     BackFaces back_faces = BackFaces::Occlude;
     // false (the seed's definition): the sums above, clamped to [0, 1] (rules
     //   with negative weights, and the rule's own error for the clamped cosine,
@@ -91,8 +92,7 @@ struct BakeOptions {
     TraceMethod method = TraceMethod::Bvh;
 };
 
-// The ray offset a bake uses for this mesh: options.ray_offset if ≥ 0, else
-// kDefaultRayOffsetScale × the bounding-box diagonal.
+// The ray offset a bake uses: options.ray_offset if > 0, else 0.
 float resolve_ray_offset(const Mesh& mesh, const BakeOptions& options);
 
 // [SECTION] Bake outputs ----------------------------------------------------------------

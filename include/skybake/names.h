@@ -24,7 +24,8 @@ template <class E>
 struct NamedValue {
     E value;
     const char* name;
-    const char* help = nullptr; // a few words for error messages and --help; may be null
+    const char* help = nullptr;  // a few words for error messages and --help; may be null
+    const char* former = nullptr; // an older name still accepted by parse_name(); may be null
 };
 
 // "a (help), b or c (help)": the choices as an error message lists them.
@@ -48,7 +49,7 @@ const char* name_of(const NamedValue<E> (&table)[N], E value) {
 template <class E, std::size_t N>
 E parse_name(const NamedValue<E> (&table)[N], std::string_view text, std::string_view what, std::string_view where) {
     for (const NamedValue<E>& e : table)
-        if (text == e.name)
+        if (text == e.name || (e.former && text == e.former))
             return e.value;
     std::vector<std::string_view> names;
     std::vector<const char*> help;

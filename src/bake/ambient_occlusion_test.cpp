@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -23,6 +24,7 @@
 #include <glm/geometric.hpp>
 
 #include "bake/ao_test_util.h"
+#include "bake/driver.h"
 #include "skybake/bake.h"
 #include "skybake/core.h"
 #include "skybake/error.h"
@@ -241,13 +243,23 @@ TEST(AmbientOcclusion, InfiniteWallLimit) {
     }
 }
 
-TEST(AmbientOcclusion, InvariantUnderTranslationAndUniformScaling) {
+TEST(AmbientOcclusion, InvariantUnderScalingNearlyUnderTranslation) {
+    // A ray origin steps 2^-15 of the vertex's largest coordinate (or of its
+    // triangles' size) off the vertex: that scales with the mesh, so uniform
+    // scaling changes no bit. Translation changes the coordinates' magnitude,
+    // hence the step, and a ray that starts exactly on another surface (a
+    // wall's bottom vertex on the ground, a roof vertex on a wall's top edge)
+    // or grazes an edge can flip. Measured on this city, whose buildings touch
+    // the ground and each other everywhere: 23–27% of the vertices move, by a
+    // few directions (4 w_k ≈ 0.013 each), rms 4.5e-3 to 5.0e-3, max 6.1e-2.
     const Mesh base = generated(ProceduralKind::City, 3000);
     const SphereRule rule = parse_rule("lebedev:302+rotate");
     Mesh a = base;
     bake_ambient_occlusion(a, rule);
-    for (const auto& [scale, shift] : {std::pair{1.0f, glm::vec3(12.5f, -3.0f, 7.25f)},
-                                       std::pair{40.0f, glm::vec3(0.0f)}, std::pair{0.02f, glm::vec3(0.3f, 0.1f, -0.2f)}}) {
+    for (const auto& [scale, shift] :
+         {std::pair{4.0f, glm::vec3(0.0f)}, std::pair{0.125f, glm::vec3(0.0f)},
+          std::pair{1.0f, glm::vec3(12.5f, -3.0f, 7.25f)}, std::pair{40.0f, glm::vec3(0.0f)},
+          std::pair{0.02f, glm::vec3(0.3f, 0.1f, -0.2f)}}) {
         Mesh b = base;
         for (auto& p : b.positions)
             p = p * scale + shift;
@@ -262,10 +274,13 @@ TEST(AmbientOcclusion, InvariantUnderTranslationAndUniformScaling) {
         }
         std::printf("scale %g shift (%g %g %g): AO changed at %zu of %zu vertices, max %.2e rms %.2e\n", scale,
                     shift.x, shift.y, shift.z, moved, x.size(), e.worst, e.rms());
-        // Rounding of the moved coordinates can flip a ray that grazes an edge:
-        // a few directions at a few vertices, 4 w_k ≈ 0.013 each.
-        EXPECT_LT(e.rms(), 2e-3);
-        EXPECT_LT(double(moved), 0.02 * double(x.size()));
+        if (shift == glm::vec3(0.0f)) {
+            EXPECT_EQ(moved, 0u) << "scale " << scale;
+            continue;
+        }
+        EXPECT_LT(e.rms(), 6e-3);
+        EXPECT_LT(e.worst, 8e-2);
+        EXPECT_LT(double(moved), 0.3 * double(x.size()));
     }
 }
 
@@ -453,4 +468,109 @@ TEST(AmbientOcclusion, BakeComputesMissingNormals) {
     if (cuda_device_count() == 0) { // without a GPU (or CUDA) "cuda" is a clear error
         EXPECT_THROW(bake_ambient_occlusion(m, parse_rule("lebedev:50"), "cuda"), Error);
     }
+}
+
+// Ray origins that neither leak nor jump (skybake/bake.h, [SECTION] Bake
+// options): a step of 256 ulps past rounding, no scene-relative offset.
+
+TEST(RayOrigins, AThinGapIsNotJumped) {
+    // A floor patch under a ceiling 1e-5 of the scene's diagonal above it,
+    // facing it: the patch's centre sees the ceiling over the whole
+    // hemisphere but for rays within atan(gap / 50) of the horizon, so AO is
+    // below 1e-4 (the rule puts no direction that close to the horizon but
+    // the horizon's own orbit, which the ceiling blocks too). A scene-relative
+    // offset of 1e-4 × the diagonal jumps the gap and sees open sky.
+    const float L = 50.0f;
+    Mesh m;
+    m.positions = {{-0.01f, 0, -0.01f}, {0.01f, 0, -0.01f}, {0.01f, 0, 0.01f}, {-0.01f, 0, 0.01f}, {0, 0, 0}};
+    m.indices = {4, 1, 0, 4, 2, 1, 4, 3, 2, 4, 0, 3};
+    // Diagonal about 141: the gap is 1.4e-3.
+    const float gap = 1e-5f * std::sqrt(2.0f) * 2.0f * L;
+    const auto base = std::uint32_t(m.positions.size());
+    m.positions.insert(m.positions.end(), {{-L, gap, -L}, {L, gap, -L}, {L, gap, L}, {-L, gap, L}});
+    m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3}); // front faces down
+    compute_normals(m);
+    ASSERT_NEAR(m.normals[4].y, 1.0f, 1e-6f);
+    const SphereRule rule = parse_rule("lebedev:590+rotate");
+    for (const char* backend : {"embree", "brute"}) {
+        Mesh a = m;
+        bake_ambient_occlusion(a, rule, backend);
+        EXPECT_LT(a.find_attribute("ao")->values[4], 1e-4f) << backend;
+        BakeOptions jump;
+        jump.ray_offset = 1e-4f * compute_bounds(m).diagonal(); // the former default
+        Mesh b = m;
+        bake_ambient_occlusion(b, rule, backend, jump);
+        EXPECT_GT(b.find_attribute("ao")->values[4], 0.9f) << backend << ": the old offset jumps the gap";
+    }
+}
+
+TEST(RayOrigins, CurvedSurfacesNeedNoOffset) {
+    // A tessellated sphere, outside and inside, with no offset at all: no ray
+    // meets the vertex's own triangles. Outside, every direction on or above
+    // a vertex's horizon is visible (the sphere is convex, and its vertex
+    // normals are normals of supporting planes); inside, none is (AO = A = 0).
+    // The rule is turned per vertex: an unturned symmetric rule on the
+    // symmetric icosphere sends rays exactly through far vertices, where a
+    // ray–triangle test that is not watertight (Möller–Trumbore in the
+    // brute-force oracle and the CUDA traversal, Embree's default mode) can
+    // let one through.
+    const SphereRule rule = parse_rule("lebedev:590+rotate");
+    const std::vector<glm::vec3> points = rule.points_f32();
+    const bake::VisitingRule visit = bake::visiting_rule(rule); // the bake's rotations, in float
+    for (bool inside : {false, true}) {
+        Mesh m = generated(ProceduralKind::Sphere, 2000);
+        if (inside) {
+            for (std::size_t t = 0; t < m.triangle_count(); ++t)
+                std::swap(m.indices[3 * t + 1], m.indices[3 * t + 2]);
+            m.normals.clear();
+        }
+        BakeOptions o;
+        o.ray_offset = 0.0f;
+        o.store_bits = true;
+        for (const char* backend : {"embree", "brute"}) {
+            Mesh b = m;
+            BakeOutputs out;
+            bake_ambient_occlusion(b, rule, backend, o, &out);
+            std::size_t wrong = 0;
+            for (std::size_t v = 0; v < b.vertex_count(); ++v) {
+                const glm::vec3 n = glm::normalize(b.normals[v]);
+                const glm::mat3 turn = visit.rotation(std::uint32_t(v));
+                for (std::size_t k = 0; k < points.size(); ++k)
+                    wrong += out.visible(v, k) != (!inside && glm::dot(n, turn * points[k]) >= 0.0f);
+                if (inside) {
+                    ASSERT_LT(out.ao[v], 1e-3f) << backend << " vertex " << v;
+                    ASSERT_LT(out.shading[v], 1e-2f) << backend << " vertex " << v;
+                }
+            }
+            // Outside: none wrong. Inside, a ray just above the horizon meets
+            // the next triangle a few ulps from its origin, at grazing
+            // incidence, close to a shared edge, and a test that is not
+            // watertight can let one through: measured, 1 of 591,180
+            // directions (Embree), 0 (brute force).
+            const std::size_t all = b.vertex_count() * points.size();
+            std::printf("%s, %s: %zu of %zu directions wrong\n", backend, inside ? "inside" : "outside", wrong, all);
+            if (inside) {
+                EXPECT_LE(double(wrong), 1e-5 * double(all)) << backend;
+            } else {
+                EXPECT_EQ(wrong, 0u) << backend;
+            }
+        }
+    }
+}
+
+TEST(RayOrigins, TheStepPastRoundingScalesWithTheCoordinates) {
+    // 2^-15 of the largest coordinate or of the triangles' size, whichever is
+    // larger: 256 to 512 ulps of a float.
+    EXPECT_EQ(bake::rounding_step(glm::vec3(1000.0f, -3.0f, 2.0f), 0.5f), 1000.0f * 0x1p-15f);
+    EXPECT_EQ(bake::rounding_step(glm::vec3(0.0f, -0.25f, 0.0f), 0.01f), 0.25f * 0x1p-15f);
+    EXPECT_EQ(bake::rounding_step(glm::vec3(0.0f), 0.01f), 0.01f * 0x1p-15f);
+    const float ulp = std::nextafter(1000.0f, INFINITY) - 1000.0f;
+    const float ulps = bake::rounding_step(glm::vec3(1000.0f, 0, 0), 0.0f) / ulp; // 256 to 512 ulps
+    EXPECT_GE(ulps, 256.0f);
+    EXPECT_LE(ulps, 512.0f);
+    // The origin moves along n + u, whatever the coordinates.
+    const glm::vec3 p(-23.0f, -7.4f, 0.58f), n(0.24f, -0.42f, 0.876f), u(-0.73f, 0.51f, 0.45f);
+    const float step = bake::rounding_step(p, 0.5f);
+    const glm::vec3 d = bake::ray_origin(p, n, u, 0.0f, step) - p;
+    EXPECT_NEAR(glm::dot(d, glm::normalize(n)), step * glm::dot(n + u, glm::normalize(n)), 1e-3f * step);
 }

@@ -2,24 +2,42 @@
 // that tests check on their own: ray origins and the direction order.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
-#include "core/hd.h"
 #include "skybake/bake.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 
 namespace skybake::bake {
 
-// Ray origin: the vertex moved by `offset` (mesh units) along its unit normal
-// and along `inward`, a unit tangent towards its own triangles for vertices on
-// a border or a crease (zero elsewhere; see vertex_inward_directions()).
-SKYBAKE_HD_INLINE glm::vec3 ray_origin(const glm::vec3& position, const glm::vec3& normal, const glm::vec3& inward,
-                                       float offset) {
-    return position + offset * (normal + inward);
+// How far a ray origin must step off its vertex to clear the rounding of the
+// ray–triangle tests at the vertex's own triangles: 2^-15 (256 to 512 units
+// in the last place of a float) of the larger of the vertex's largest coordinate
+// and its triangles' size (the mean distance to their centroids). The idea
+// is Wächter & Binder's ("A Fast and Robust Method for Avoiding
+// Self-Intersection", Ray Tracing Gems, ch. 6, 2019): an offset tied to the
+// precision of the coordinates, not to the scene's size, so it is far
+// smaller than any real gap. Unlike their per-coordinate integer step, one
+// step for all three axes keeps the direction of the move: a vertex normal
+// is not a face normal, and a move skewed towards the largest coordinate can
+// end behind the vertex's own triangles.
+inline float rounding_step(const glm::vec3& position, float triangle_size) {
+    const float magnitude = std::max({std::abs(position.x), std::abs(position.y), std::abs(position.z)});
+    return 0x1p-15f * std::max(magnitude, triangle_size);
+}
+
+// Ray origin: the vertex moved along d = normal + inward (a unit tangent
+// towards its own triangles for vertices on a border or a crease, zero
+// elsewhere; see vertex_inward_directions()) by `offset` (mesh units; 0 by
+// default) plus `step` (rounding_step()).
+inline glm::vec3 ray_origin(const glm::vec3& position, const glm::vec3& normal, const glm::vec3& inward, float offset,
+                            float step) {
+    return position + (offset + step) * (normal + inward);
 }
 
 // Per vertex: the unit tangent from the vertex towards the area-weighted mean
@@ -58,9 +76,10 @@ VisitingRule visiting_rule(const SphereRule& rule);
 struct VertexRays {
     float offset = 0.0f; // mesh units
     std::vector<glm::vec3> normals, inward;
+    std::vector<float> steps; // rounding_step() of each vertex
 
     glm::vec3 origin(const Mesh& mesh, std::size_t vertex) const {
-        return ray_origin(mesh.positions[vertex], normals[vertex], inward[vertex], offset);
+        return ray_origin(mesh.positions[vertex], normals[vertex], inward[vertex], offset, steps[vertex]);
     }
 };
 VertexRays vertex_rays(const Mesh& mesh, const BakeOptions& options);

@@ -58,10 +58,8 @@ void check_inputs(const Mesh& mesh, const SphereRule& rule, const BakeOptions& o
 
 } // namespace
 
-float resolve_ray_offset(const Mesh& mesh, const BakeOptions& options) {
-    if (options.ray_offset >= 0.0f)
-        return options.ray_offset;
-    return kDefaultRayOffsetScale * compute_bounds(mesh).diagonal();
+float resolve_ray_offset(const Mesh&, const BakeOptions& options) {
+    return options.ray_offset > 0.0f ? options.ray_offset : 0.0f;
 }
 
 VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, VisibilityTracer& tracer,
@@ -181,6 +179,22 @@ VertexRays vertex_rays(const Mesh& mesh, const BakeOptions& options) {
     r.offset = resolve_ray_offset(mesh, options);
     r.normals = bake_normals(mesh);
     r.inward = vertex_inward_directions(mesh, r.normals);
+    // Each vertex's triangle size: the mean distance to their centroids.
+    std::vector<double> dist(mesh.vertex_count(), 0.0);
+    std::vector<std::uint32_t> count(mesh.vertex_count(), 0);
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+        const std::uint32_t* i = &mesh.indices[3 * t];
+        const glm::dvec3 c = (glm::dvec3(mesh.positions[i[0]]) + glm::dvec3(mesh.positions[i[1]]) +
+                              glm::dvec3(mesh.positions[i[2]])) /
+                             3.0;
+        for (int k = 0; k < 3; ++k) {
+            dist[i[k]] += glm::length(c - glm::dvec3(mesh.positions[i[k]]));
+            ++count[i[k]];
+        }
+    }
+    r.steps.resize(mesh.vertex_count());
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        r.steps[v] = rounding_step(mesh.positions[v], count[v] ? float(dist[v] / count[v]) : 0.0f);
     return r;
 }
 

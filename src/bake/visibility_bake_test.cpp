@@ -254,11 +254,12 @@ TEST(VisibilityBake, Errors) {
     EXPECT_THROW(bake_shading(bad, rule, *b, BakeOptions{}, out), Error);
 }
 
-TEST(VisibilityBake, DefaultOffsetScalesWithTheMesh) {
+TEST(VisibilityBake, TheUserOffsetIsZeroByDefault) {
     Mesh m = random_mesh(2, 10);
-    const float d = compute_bounds(m).diagonal();
-    EXPECT_FLOAT_EQ(resolve_ray_offset(m, {}), kDefaultRayOffsetScale * d);
+    EXPECT_EQ(resolve_ray_offset(m, {}), 0.0f);
     BakeOptions o;
+    o.ray_offset = -1.0f; // the former "scene-relative default"
+    EXPECT_EQ(resolve_ray_offset(m, o), 0.0f);
     o.ray_offset = 0.5f;
     EXPECT_FLOAT_EQ(resolve_ray_offset(m, o), 0.5f);
 }

@@ -272,7 +272,7 @@ SkyModel neural_reference_model(const NeuralSky& net) { return SkyModel(net.atmo
 
 namespace {
 constexpr NamedValue<BrightnessEncoding> kBrightnessNames[] = {
-    {BrightnessEncoding::Linear, "linear", "the paper's"},
+    {BrightnessEncoding::Linear, "linear", "the paper's", "seed"},
     {BrightnessEncoding::Log, "log", "a fixed relative error over many decades"},
 };
 } // namespace
@@ -280,8 +280,6 @@ constexpr NamedValue<BrightnessEncoding> kBrightnessNames[] = {
 const char* brightness_encoding_name(BrightnessEncoding encoding) { return name_of(kBrightnessNames, encoding); }
 
 BrightnessEncoding parse_brightness_encoding(const std::string& text, const std::string& where) {
-    if (text == "seed") // the name files and scripts used before
-        return BrightnessEncoding::Linear;
     return parse_name(kBrightnessNames, text, "brightness encoding", where);
 }
 

@@ -29,14 +29,12 @@ constexpr NamedValue<PhaseFunction> kPhaseNames[] = {
     {PhaseFunction::Rayleigh, "rayleigh"},
     {PhaseFunction::HenyeyGreenstein, "henyey-greenstein"},
     {PhaseFunction::CornetteShanks, "cornette-shanks"},
-    {PhaseFunction::PietrasRudnickiMie, "pietras-rudnicki-mie"},
+    {PhaseFunction::PietrasRudnickiMie, "pietras-rudnicki-mie", nullptr, "seed-mie"},
 };
 
 const char* phase_name(PhaseFunction p) { return name_of(kPhaseNames, p); }
 
 PhaseFunction parse_phase(const std::string& s, const std::string& where) {
-    if (s == "seed-mie") // the name files used before
-        return PhaseFunction::PietrasRudnickiMie;
     return parse_name(kPhaseNames, s, "phase function", where);
 }
 
@@ -44,7 +42,7 @@ PhaseFunction parse_phase(const std::string& s, const std::string& where) {
 
 namespace {
 constexpr NamedValue<TableRule> kTableRuleNames[] = {
-    {TableRule::AsPublished, "as-published", "the paper's density at the shell boundary"},
+    {TableRule::AsPublished, "as-published", "the paper's density at the shell boundary", "seed"},
     {TableRule::Refined, "refined", "sub-shells weighted by their mean density"},
 };
 } // namespace
@@ -52,8 +50,6 @@ constexpr NamedValue<TableRule> kTableRuleNames[] = {
 const char* table_rule_name(TableRule rule) { return name_of(kTableRuleNames, rule); }
 
 TableRule parse_table_rule(const std::string& text, const std::string& where) {
-    if (text == "seed") // the name files and scripts used before
-        return TableRule::AsPublished;
     return parse_name(kTableRuleNames, text, "table rule", where);
 }
 
