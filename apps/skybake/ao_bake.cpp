@@ -40,13 +40,6 @@ struct AoOptions {
     bool json = false;
 };
 
-// API fields of the bake → the flags that set them.
-constexpr std::pair<std::string_view, std::string_view> kBakeFlags[] = {
-    {"max_distance", "--max-distance"}, {"ray_offset", "--offset"}, {"rule", "--rule"},
-    {"method", "--method"},             {"backend", "--backend"},   {"device", "--device cuda"},
-    {"back_faces", "--back-faces"},
-};
-
 nlohmann::json stats(const std::vector<float>& v) {
     if (v.empty())
         return nullptr;
@@ -100,9 +93,7 @@ void run(const AoOptions& o, const CLI::App& sub) {
         check_output_path(o.preview, {".png", ".exr"}, "--preview");
     if (!o.bits.empty())
         check_output_path(o.bits, {}, "--bits");
-    const FlagNames flags = kBakeFlags;
-    // No GPU: a runtime error, exit 1.
-    const auto tracer = with_flag_names(flags, [&] { return make_visibility_tracer(backend_id, method); });
+    const auto tracer = make_visibility_tracer(backend_id, method); // no GPU: a runtime error, exit 1
 
     BakeOptions b;
     b.max_distance = float(o.max_distance);
@@ -114,8 +105,7 @@ void run(const AoOptions& o, const CLI::App& sub) {
 
     Mesh mesh = load_mesh(o.input);
     BakeOutputs outputs;
-    const AoBakeReport r =
-        with_flag_names(flags, [&] { return bake_ambient_occlusion(mesh, rule, *tracer, b, &outputs); });
+    const AoBakeReport r = bake_ambient_occlusion(mesh, rule, *tracer, b, &outputs);
 
     // Every output is staged, then all are committed together: a failure in
     // any one of them leaves none written.

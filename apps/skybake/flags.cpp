@@ -151,4 +151,43 @@ void refuse_if_given(const CLI::App& sub, const char* flag, const std::string& r
         throw UsageError(fmt::format("{} does not apply {}", flag, reason), flag);
 }
 
+std::string flag_for_field(const std::string& where) {
+    // API field (library Error::where()) → flag. A field that several
+    // commands share ("samples") is set by the same flag in each.
+    static const std::pair<const char*, const char*> kFields[] = {
+        {"max_distance", "--max-distance"},
+        {"ray_offset", "--offset"},
+        {"rule", "--rule"},
+        {"method", "--method"},
+        {"backend", "--backend"},
+        {"device", "--device cuda"},
+        {"back_faces", "--back-faces"},
+        {"preset", "--preset"},
+        {"paper_r/paper_m", "--paper-r/--paper-m"},
+        {"table_rule", "--table-rule"},
+        {"altitude_km", "--altitude-km"},
+        {"sun_elevation_deg", "--sun-elevation-deg"},
+        {"sun_azimuth_deg", "--sun-azimuth-deg"},
+        {"fov_deg", "--fov"},
+        {"yaw_deg/pitch_deg", "--yaw/--pitch"},
+        {"width/height", "--size"},
+        {"view_width/view_height", "--size"},
+        {"topology", "--topology"},
+        {"samples", "--samples"},
+        {"heldout_samples", "--heldout"},
+        {"adam_epochs/lm_iterations", "--epochs/--lm-iterations"},
+        {"batch", "--batch"},
+        {"learning_rate", "--learning-rate"},
+        {"log_range", "--log-range"},
+        {"brightness", "--brightness"},
+        {"name", "--name"},
+        {"kind", "--kind"},
+        {"target_triangles", "--triangles"},
+    };
+    for (const auto& [field, flag] : kFields)
+        if (where == field)
+            return flag;
+    return where;
+}
+
 } // namespace skybake::cli

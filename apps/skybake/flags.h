@@ -55,24 +55,11 @@ auto parse_flag(const char* flag, F&& parse) -> decltype(parse()) {
     }
 }
 
-// The library names the API field at fault (Error::where(), e.g.
-// "max_distance"); the CLI speaks of flags. Runs f, and rethrows an Error
-// whose where() is a field of `flags` ({field, flag} pairs) as the same Error
-// naming the flag, so the user reads "(--max-distance)".
-using FlagNames = std::span<const std::pair<std::string_view, std::string_view>>;
-template <class F>
-auto with_flag_names(FlagNames flags, F&& f) -> decltype(f()) {
-    try {
-        return f();
-    } catch (const UsageError&) {
-        throw;
-    } catch (const Error& e) {
-        for (const auto& [field, flag] : flags)
-            if (e.where() == field)
-                throw Error(e.message(), std::string(flag));
-        throw;
-    }
-}
+// The library names the API field at fault in Error::where() (e.g.
+// "max_distance"); the CLI speaks of flags. The flag that sets `where`, from
+// the one table of the CLI (flags.cpp), or `where` itself when no flag sets
+// it (a file name, "mesh"). main() applies it to every error it prints.
+std::string flag_for_field(const std::string& where);
 
 // Checks an output path before any work: a known extension (a usage error
 // otherwise), an existing, writable folder, and not a folder itself (exit 1:

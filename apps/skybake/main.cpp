@@ -112,7 +112,7 @@ int main(int argc, char** argv) {
         print_error(e.what());
         return 128 + e.signal();
     } catch (const skybake::Error& e) {
-        print_error(e.what());
+        print_error(skybake::format_error_line(e.message(), skybake::cli::flag_for_field(e.where())));
         return 1;
     } catch (const std::bad_alloc&) {
         print_error("out of memory");

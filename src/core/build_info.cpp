@@ -31,7 +31,7 @@ void require_cuda_device(const std::string& where) {
                     "/usr/local/cuda)",
                     where);
     if (cuda_device_count() == 0)
-        throw Error("no usable CUDA device (" + cuda_device_problem() + "); use --device cpu", where);
+        throw Error("no usable CUDA device (" + cuda_device_problem() + "); use the CPU instead", where);
 }
 
 Device parse_device(const std::string& name, const std::string& where) {

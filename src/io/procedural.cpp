@@ -279,7 +279,7 @@ ProceduralKind parse_procedural_kind(const std::string& name) {
     std::string all;
     for (const auto& k : kKinds)
         all += std::string(all.empty() ? "" : ", ") + k.name;
-    throw Error(fmt::format("unknown mesh kind '{}'; choose one of {}", name, all), "--kind");
+    throw Error(fmt::format("unknown mesh kind '{}'; choose one of {}", name, all), "kind");
 }
 
 const char* procedural_kind_name(ProceduralKind kind) {
@@ -300,7 +300,7 @@ Mesh generate_mesh(const ProceduralOptions& o) {
     constexpr std::uint64_t kMax = 50'000'000;
     if (o.target_triangles < 20 || o.target_triangles > kMax)
         throw Error(fmt::format("triangle count {} is out of range; use 20 to {}", o.target_triangles, kMax),
-                    "--triangles");
+                    "target_triangles");
     switch (o.kind) {
     case ProceduralKind::Sphere: return icosphere(o.target_triangles);
     case ProceduralKind::Terrain: return terrain(o.target_triangles, o.seed);

@@ -37,9 +37,9 @@ ErrorStats error_stats(std::vector<double>& e) {
 NeuralErrorReport measure_neural_sky_error(const NeuralSky& net, const NeuralErrorOptions& o) {
     net.validate("neural sky");
     if (o.samples < 1 || o.samples > (std::size_t(1) << 28))
-        throw Error("the number of samples must be 1 to 2^28", "--samples");
+        throw Error("the number of samples must be 1 to 2^28", "samples");
     if (o.views && (o.view_width < 1 || o.view_height < 1 || o.view_width > 4096 || o.view_height > 4096))
-        throw Error("view size must be 1 to 4096 pixels on each side", "--size");
+        throw Error("view size must be 1 to 4096 pixels on each side", "view_width/view_height");
     const SkyModel model = neural_reference_model(net);
     const std::vector<SkySample> samples = draw_sky_samples(o.samples, o.seed);
     std::vector<glm::vec3> ref(samples.size()), got(samples.size());

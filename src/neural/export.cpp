@@ -74,7 +74,7 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const s
         throw Error(fmt::format("'{}' is not a valid function name (letters, digits and _, not starting with a digit "
                                 "or gl_)",
                                 name),
-                    "--name");
+                    "name");
     const Dialect d = dialect(lang);
     const Layout lay = make_layout(net.topology);
     const std::string f = name + "_f";

@@ -152,7 +152,7 @@ const float* place_weights(const NeuralSky& net, cuda::DeviceBuffer<float>& glob
 } // namespace
 
 GpuThroughput measure_neural_sky_cuda(const NeuralSky& net, std::uint64_t samples, bool force_generic) {
-    require_cuda_device("--device cuda");
+    require_cuda_device("device");
     const MlpHD m = make_mlp_hd(net);
     cuda::DeviceBuffer<float> global;
     const float* weights = place_weights(net, global);
@@ -199,7 +199,7 @@ namespace skybake {
 
 void evaluate_neural_sky_cuda(const NeuralSky& net, std::span<const SkySample> samples, std::span<glm::vec3> out) {
     using namespace neural;
-    require_cuda_device("--device cuda");
+    require_cuda_device("device");
     if (samples.size() != out.size())
         throw Error("evaluate_neural_sky_cuda: output size differs from the sample count");
     if (samples.empty())
@@ -228,7 +228,7 @@ Image render_neural_sky_cuda(const NeuralSky& net, const SkyModel& model, const 
     using namespace neural;
     net.validate("neural sky");
     sky::RenderHD p = sky::make_render_hd(model, settings);
-    require_cuda_device("--device cuda");
+    require_cuda_device("device");
     // The tables (for the ground and the sun) on the device.
     std::vector<cuda::DeviceBuffer<float>> tables(std::size_t(p.atm.count));
     for (int k = 0; k < p.atm.count; ++k) {

@@ -6,17 +6,17 @@
 namespace skybake {
 
 void evaluate_neural_sky_cuda(const NeuralSky&, std::span<const SkySample>, std::span<glm::vec3>) {
-    require_cuda_device("--device cuda"); // throws
+    require_cuda_device("device"); // throws
 }
 
 Image render_neural_sky_cuda(const NeuralSky&, const SkyModel&, const SkyRenderSettings&) {
-    require_cuda_device("--device cuda"); // throws
+    require_cuda_device("device"); // throws
     return {};
 }
 
 namespace neural {
 GpuThroughput measure_neural_sky_cuda(const NeuralSky&, std::uint64_t, bool) {
-    require_cuda_device("--device cuda"); // throws
+    require_cuda_device("device"); // throws
     return {};
 }
 } // namespace neural

@@ -220,19 +220,19 @@ NormalPart normal_equations(const Layout& lay, const std::vector<float>& w, int 
 } // namespace
 
 NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, std::vector<LearningCurvePoint>* curve) {
-    o.topology.validate("--topology");
+    o.topology.validate("topology");
     if (o.samples < 16 || o.samples > (std::size_t(1) << 31))
-        throw Error("the number of training samples must be 16 to 2^31", "--samples");
+        throw Error("the number of training samples must be 16 to 2^31", "samples");
     if (o.heldout_samples < 1 || o.max_n_samples < 1)
-        throw Error("held-out and max{N} sample counts must be at least 1", "--heldout");
+        throw Error("held-out and max{N} sample counts must be at least 1", "heldout_samples");
     if (o.adam_epochs < 0 || o.lm_iterations < 0 || o.adam_epochs + o.lm_iterations > 100000)
-        throw Error("epochs and LM iterations must be 0 to 100000", "--epochs/--lm-iterations");
+        throw Error("epochs and LM iterations must be 0 to 100000", "adam_epochs/lm_iterations");
     if (o.batch < 1 || o.batch > o.samples)
-        throw Error("the mini-batch must hold 1 to --samples samples", "--batch");
+        throw Error("the mini-batch must hold 1 to `samples` samples", "batch");
     if (!(o.learning_rate > 0.0 && o.learning_rate_final > 0.0 && o.learning_rate < 10.0))
-        throw Error("learning rates must be positive (and below 10)", "--learning-rate");
+        throw Error("learning rates must be positive (and below 10)", "learning_rate");
     if (o.brightness == BrightnessEncoding::Log && !(o.log_range > 0.0 && o.log_range < 200.0))
-        throw Error("the log range must be in (0, 200) nats", "--log-range");
+        throw Error("the log range must be in (0, 200) nats", "log_range");
 
     const auto t0 = std::chrono::steady_clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };

@@ -213,7 +213,7 @@ Atmosphere atmosphere_preset(std::string_view name, double paper_r, double paper
         if (name == "paper-dense")
             paper_r = paper_m = 100.0;
         if (!(std::isfinite(paper_r) && paper_r > 0 && std::isfinite(paper_m) && paper_m > 0))
-            throw Error("the paper preset's r and m must be positive", "--paper-r/--paper-m");
+            throw Error("the paper preset's r and m must be positive", "paper_r/paper_m");
         a.name = name == "paper" ? fmt::format("paper r={:g} m={:g}", paper_r, paper_m) : std::string(name);
         a.planet_radius_km = 6371.0;
         a.top_radius_km = 6471.0;
@@ -228,7 +228,7 @@ Atmosphere atmosphere_preset(std::string_view name, double paper_r, double paper
         a.sun_elevation_deg = 30.0;
         return a;
     }
-    throw Error(fmt::format("unknown atmosphere preset '{}'; use earth, paper or paper-dense", name), "--preset");
+    throw Error(fmt::format("unknown atmosphere preset '{}'; use earth, paper or paper-dense", name), "preset");
 }
 
 // ---- JSON ------------------------------------------------------------------------------------

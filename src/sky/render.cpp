@@ -56,17 +56,17 @@ namespace sky {
 RenderHD make_render_hd(const SkyModel& model, const SkyRenderSettings& s) {
     const Atmosphere& atm = model.atmosphere();
     if (!(std::isfinite(s.altitude_km) && s.altitude_km >= 0.0 && s.altitude_km < 1e7))
-        throw Error("the observer altitude must be 0 to 1e7 km", "--altitude-km");
+        throw Error("the observer altitude must be 0 to 1e7 km", "altitude_km");
     if (!(std::isfinite(s.sun_elevation_deg) && std::abs(s.sun_elevation_deg) <= 90.0))
-        throw Error("the sun elevation must be in [-90, 90] degrees", "--sun-elevation-deg");
+        throw Error("the sun elevation must be in [-90, 90] degrees", "sun_elevation_deg");
     if (!std::isfinite(s.sun_azimuth_deg))
-        throw Error("the sun azimuth must be a finite number of degrees", "--sun-azimuth-deg");
+        throw Error("the sun azimuth must be a finite number of degrees", "sun_azimuth_deg");
     if (s.view == SkyView::Camera && !(s.fov_deg > 0.0 && s.fov_deg < 180.0))
-        throw Error("the field of view must be in (0, 180) degrees", "--fov");
+        throw Error("the field of view must be in (0, 180) degrees", "fov_deg");
     if (!(std::isfinite(s.yaw_deg) && std::isfinite(s.pitch_deg) && std::abs(s.pitch_deg) <= 90.0))
-        throw Error("yaw must be finite and pitch in [-90, 90] degrees", "--yaw/--pitch");
+        throw Error("yaw must be finite and pitch in [-90, 90] degrees", "yaw_deg/pitch_deg");
     if (s.width < 1 || s.height < 1 || s.width > 16384 || s.height > 16384)
-        throw Error("image size must be 1 to 16384 pixels on each side", "--size");
+        throw Error("image size must be 1 to 16384 pixels on each side", "width/height");
 
     sky::RenderHD p;
     p.atm = *static_cast<const sky::AtmosphereHD*>(model.device_view());

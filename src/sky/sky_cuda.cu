@@ -55,7 +55,7 @@ struct DeviceAtmosphere {
 } // namespace
 
 void evaluate_sky_cuda(const SkyModel& model, std::span<const SkySample> samples, std::span<glm::vec3> out) {
-    require_cuda_device("--device cuda");
+    require_cuda_device("device");
     if (samples.size() != out.size())
         throw Error("evaluate_sky_cuda: output size differs from the sample count");
     if (samples.empty())
@@ -87,9 +87,9 @@ void evaluate_sky_cuda(const SkyModel& model, std::span<const SkySample> samples
 
 Image render_sky_cuda(const SkyModel& model, const SkyRenderSettings& settings) {
     if (settings.method != SkyMethod::Tables)
-        throw Error("the exact method runs on the CPU only; use --device cpu or --method tables", "--device cuda");
+        throw Error("the exact method runs on the CPU only; use the CPU or the tables method", "device");
     sky::RenderHD p = sky::make_render_hd(model, settings);
-    require_cuda_device("--device cuda");
+    require_cuda_device("device");
     DeviceAtmosphere atm(model);
     p.atm = atm.hd;
     Image image(settings.width, settings.height);

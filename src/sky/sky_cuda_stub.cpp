@@ -7,13 +7,13 @@
 namespace skybake {
 
 void evaluate_sky_cuda(const SkyModel&, std::span<const SkySample>, std::span<glm::vec3>) {
-    require_cuda_device("--device cuda"); // throws
+    require_cuda_device("device"); // throws
 }
 
 Image render_sky_cuda(const SkyModel&, const SkyRenderSettings& settings) {
     if (settings.method != SkyMethod::Tables) // the same first check as the CUDA build's
-        throw Error("the exact method runs on the CPU only; use --device cpu or --method tables", "--device cuda");
-    require_cuda_device("--device cuda"); // throws
+        throw Error("the exact method runs on the CPU only; use the CPU or the tables method", "device");
+    require_cuda_device("device"); // throws
     return {};
 }
 

@@ -137,7 +137,7 @@ public:
                 throw Error(fmt::format("the BVH needs more than {} triangle references; the CUDA backend takes "
                                         "meshes up to about 100 million triangles",
                                         kMaxBvhTriangleRefs),
-                            "--backend cuda");
+                            "backend");
             for (std::uint32_t k = 0; k < l->count; ++k)
                 out_.triangles.push_back(out_.soup[l->ids[k]]);
             return encode_leaf(first, l->count);
@@ -199,7 +199,7 @@ Bvh build_bvh(const Mesh& mesh, bool spatial_splits) {
         throw Error(fmt::format("{} triangles is too many for the CUDA backend's BVH (at most {}); use --backend "
                                 "embree",
                                 nt, kMaxBvhTriangleRefs / 2 - 1),
-                    "--backend cuda");
+                    "backend");
 
     Bvh out;
     out.soup.resize(nt);
@@ -227,7 +227,7 @@ Bvh build_bvh(const Mesh& mesh, bool spatial_splits) {
     DeviceHolder h;
     h.device = rtcNewDevice("verbose=0");
     if (!h.device)
-        throw Error("cannot start Embree to build the BVH", "--backend cuda");
+        throw Error("cannot start Embree to build the BVH", "backend");
     rtcSetDeviceErrorFunction(h.device, &on_error, &h);
     h.bvh = rtcNewBVH(h.device);
     BuildContext ctx;
@@ -259,11 +259,11 @@ Bvh build_bvh(const Mesh& mesh, bool spatial_splits) {
         std::lock_guard lock(h.mutex);
         throw Error(fmt::format("Embree could not build the BVH of {} triangles: {}", nt,
                                 h.error.empty() ? "unknown error" : h.error),
-                    "--backend cuda");
+                    "backend");
     }
 
     if (ctx.leaf_overflow)
-        throw Error(fmt::format("Embree built a leaf of more than {} triangles", kMaxLeafTriangles), "--backend cuda");
+        throw Error(fmt::format("Embree built a leaf of more than {} triangles", kMaxLeafTriangles), "backend");
 
     Flattener flat(out, pad);
     out.nodes.reserve(2 * nt / kMaxLeafTriangles + 16);
@@ -283,7 +283,7 @@ Bvh build_bvh(const Mesh& mesh, bool spatial_splits) {
     }
     if (out.depth > kBvhStackSize)
         throw Error(fmt::format("the BVH is {} levels deep; the GPU traversal handles {}", out.depth, kBvhStackSize),
-                    "--backend cuda");
+                    "backend");
     out.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return out;
 }
