@@ -6,6 +6,7 @@
 #include "commands.h"
 #include "flags.h"
 #include "skybake/files.h"
+#include "skybake/sky_source.h"
 #include "sky_common.h"
 
 namespace skybake::cli {
@@ -65,12 +66,9 @@ void add_sky_eval(CLI::App& group) {
         const NeuralSky net = neural ? o->model.load(*sub, o->atm) : NeuralSky{};
         const SkyMethod method = neural ? SkyMethod::Tables : parse_sky_method(o->method);
         const Device device = parse_flag("--device", [&] { return parse_device(o->device); });
-        if (device == Device::Cuda) {
-            if (method == SkyMethod::Exact)
-                throw UsageError("the exact method runs on the CPU only; use --device cpu or --method tables",
-                                 "--device cuda");
-            require_cuda_device("--device cuda");
-        }
+        if (device == Device::Cuda && method == SkyMethod::Exact)
+            throw UsageError("the exact method runs on the CPU only; use --device cpu or --method tables",
+                             "--device cuda");
         if (method == SkyMethod::Exact)
             for (const char* f : {"--steps", "--uniform-steps", "--shells", "--cosines"})
                 refuse_if_given(*sub, f, "to --method exact (it integrates to a tolerance, without tables)");
@@ -80,16 +78,12 @@ void add_sky_eval(CLI::App& group) {
         opts.steps = o->steps;
         opts.uniform_steps = o->uniform;
         opts.tables = {o->shells, o->cosines};
+        // No GPU: a runtime error (exit 1), before any work.
+        const SkySource source =
+            neural ? SkySource::network(net, device) : SkySource::reference(SkyModel(atm, opts), method, device);
         const auto t0 = std::chrono::steady_clock::now();
         std::vector<glm::vec3> out(samples.size());
-        if (neural && device == Device::Cuda)
-            evaluate_neural_sky_cuda(net, samples, out);
-        else if (neural)
-            evaluate_neural_sky(net, samples, out);
-        else if (device == Device::Cuda)
-            evaluate_sky_cuda(SkyModel(atm, opts), samples, out);
-        else
-            evaluate_sky(SkyModel(atm, opts), samples, out, method);
+        source.evaluate(samples, out);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         const auto write_rows = [&](std::ostream& f) {
             f << "r,g,b\n";

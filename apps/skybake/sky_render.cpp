@@ -6,6 +6,7 @@
 #include "commands.h"
 #include "flags.h"
 #include "sky_common.h"
+#include "skybake/sky_source.h"
 
 namespace skybake::cli {
 
@@ -96,15 +97,12 @@ void add_sky_render(CLI::App& group) {
         if (lower_extension(o->output) == ".exr")
             for (const char* f : {"--exposure", "--tone"})
                 refuse_if_given(*sub, f, "to an .exr output (linear radiance)");
-        if (device == Device::Cuda)
-            require_cuda_device("--device cuda");
         SkyModelOptions opts;
         opts.steps = o->steps;
         const auto t0 = std::chrono::steady_clock::now();
-        const SkyModel model = neural ? neural_reference_model(net) : SkyModel(atm, opts);
-        const bool gpu = device == Device::Cuda;
-        const Image img = neural ? (gpu ? render_neural_sky_cuda(net, model, o->s) : render_neural_sky(net, model, o->s))
-                                 : (gpu ? render_sky_cuda(model, o->s) : render_sky(model, o->s));
+        const SkySource source = neural ? SkySource::network(net, device)
+                                        : SkySource::reference(SkyModel(atm, opts), o->s.method, device);
+        const Image img = source.render(o->s);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         tm.exposure_ev = o->exposure == "auto" ? float(auto_exposure_ev(img)) : std::stof(o->exposure);
         save_image(o->output, img, tm);

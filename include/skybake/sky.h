@@ -241,6 +241,12 @@ struct SkyModelOptions {
 // the observer along V until the ray leaves the atmosphere or meets the
 // ground; samples in the planet's shadow add nothing. Observers above the top
 // of the atmosphere (tiny ρ0) see the atmosphere from outside.
+class SkyModel;
+namespace sky {
+struct AtmosphereHD; // the flat form the CPU/GPU code of src/sky/ reads
+const AtmosphereHD& atmosphere_hd(const SkyModel& model);
+} // namespace sky
+
 class SkyModel {
 public:
     explicit SkyModel(Atmosphere atmosphere, const SkyModelOptions& options = {});
@@ -260,10 +266,8 @@ public:
     // Seed's sum with an explicit step count and spacing (for convergence studies).
     glm::dvec3 radiance_tables(const SkySample& sample, int steps, bool uniform_steps = false) const;
 
-    // Opaque view of the flat data for the shared CPU/GPU code in src/sky/.
-    const void* device_view() const;
-
 private:
+    friend const sky::AtmosphereHD& sky::atmosphere_hd(const SkyModel& model);
     int spacing() const;
     struct Impl;
     std::unique_ptr<Impl> impl_;

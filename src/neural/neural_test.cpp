@@ -15,6 +15,7 @@
 #include "skybake/core.h"
 #include "skybake/error.h"
 #include "skybake/neural.h"
+#include "skybake/sky_source.h"
 #include "neural/error_bound_test_util.h"
 
 using namespace skybake;
@@ -458,5 +459,53 @@ TEST(NeuralNames, BrightnessEncodingsHaveOneTableAndTheOlderSpelling) {
     } catch (const Error& e) {
         EXPECT_EQ(e.where(), "brightness");
         EXPECT_NE(e.message().find("linear"), std::string::npos) << e.message();
+    }
+}
+
+TEST(SkySource, EvaluatesAndRendersAsTheFunctionsItChoosesBetween) {
+    // The one object that chooses what computes the sky: on the CPU it must
+    // give exactly what the functions it dispatches to give.
+    const NeuralSky net = tiny_net(parse_topology("paper"), 8);
+    const std::vector<SkySample> samples = draw_sky_samples(500, 3);
+    std::vector<glm::vec3> a(samples.size()), b(samples.size());
+
+    const SkySource neural = SkySource::network(net);
+    EXPECT_STREQ(neural.method_name(), "neural");
+    EXPECT_TRUE(neural.is_network());
+    neural.evaluate(samples, a);
+    evaluate_neural_sky(net, samples, b);
+    EXPECT_EQ(a, b);
+
+    SkyModelOptions opts;
+    opts.steps = 12;
+    const SkySource tables = SkySource::reference(SkyModel(atmosphere_preset("earth"), opts));
+    EXPECT_STREQ(tables.method_name(), "tables");
+    EXPECT_FALSE(tables.is_network());
+    EXPECT_THROW(tables.network_weights(), Error);
+    tables.evaluate(samples, a);
+    evaluate_sky(SkyModel(atmosphere_preset("earth"), opts), samples, b, SkyMethod::Tables);
+    EXPECT_EQ(a, b);
+
+    SkyRenderSettings s;
+    s.width = s.height = 24;
+    const Image img = neural.render(s);
+    const Image ref = render_neural_sky(net, neural_reference_model(net), s);
+    ASSERT_EQ(img.width, ref.width);
+    EXPECT_EQ(img.rgb, ref.rgb);
+
+    // The exact method has no GPU path; without a GPU, CUDA is refused at once.
+    try {
+        SkySource::reference(SkyModel(atmosphere_preset("earth")), SkyMethod::Exact, Device::Cuda);
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.where(), "device");
+    }
+    if (cuda_device_count() == 0) {
+        try {
+            SkySource::network(net, Device::Cuda);
+            ADD_FAILURE() << "no error";
+        } catch (const Error& e) {
+            EXPECT_EQ(e.where(), "device");
+        }
     }
 }

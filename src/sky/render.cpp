@@ -69,7 +69,7 @@ RenderHD make_render_hd(const SkyModel& model, const SkyRenderSettings& s) {
         throw Error("image size must be 1 to 16384 pixels on each side", "width/height");
 
     sky::RenderHD p;
-    p.atm = *static_cast<const sky::AtmosphereHD*>(model.device_view());
+    p.atm = sky::atmosphere_hd(model);
     p.eye_h = float(s.altitude_km);
     p.eye_r = float(atm.planet_radius_km + s.altitude_km);
     p.sun = sky::direction_from_angles(float(s.sun_azimuth_deg * kDeg), float(s.sun_elevation_deg * kDeg));

@@ -42,7 +42,7 @@ struct DeviceAtmosphere {
     sky::AtmosphereHD hd;
 
     explicit DeviceAtmosphere(const SkyModel& model) {
-        hd = *static_cast<const sky::AtmosphereHD*>(model.device_view());
+        hd = sky::atmosphere_hd(model);
         tables.resize(std::size_t(hd.count));
         for (int k = 0; k < hd.count; ++k) {
             const std::size_t n = std::size_t(hd.comp[k].table.rows) * std::size_t(hd.comp[k].table.cols);

@@ -38,7 +38,9 @@ SkyModel& SkyModel::operator=(SkyModel&&) noexcept = default;
 const Atmosphere& SkyModel::atmosphere() const { return impl_->atmosphere; }
 const OpticalLengthTables& SkyModel::tables() const { return impl_->tables; }
 const SkyModelOptions& SkyModel::options() const { return impl_->options; }
-const void* SkyModel::device_view() const { return &impl_->hd; }
+namespace sky {
+const AtmosphereHD& atmosphere_hd(const SkyModel& model) { return model.impl_->hd; }
+} // namespace sky
 
 int SkyModel::spacing() const { return impl_->options.uniform_steps ? sky::kStepsUniform : sky::kStepsGraded; }
 
@@ -95,7 +97,7 @@ void evaluate_sky(const SkyModel& model, std::span<const SkySample> samples, std
                   SkyMethod method) {
     assert(samples.size() == out.size());
     if (method == SkyMethod::Tables) {
-        const sky::AtmosphereHD& hd = *static_cast<const sky::AtmosphereHD*>(model.device_view());
+        const sky::AtmosphereHD& hd = sky::atmosphere_hd(model);
         const Atmosphere& atm = model.atmosphere();
         const int steps = model.options().steps;
         const int spacing = model.options().uniform_steps ? sky::kStepsUniform : sky::kStepsGraded;

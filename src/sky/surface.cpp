@@ -24,7 +24,7 @@ namespace skybake {
 SurfaceLight surface_light(const SkyModel& model, const glm::dvec3& observer, const glm::dvec3& surface,
                            const glm::dvec3& sun_in, const glm::dvec3& albedo) {
     const Atmosphere& atm = model.atmosphere();
-    const sky::AtmosphereHD& hd = *static_cast<const sky::AtmosphereHD*>(model.device_view());
+    const sky::AtmosphereHD& hd = sky::atmosphere_hd(model);
     const glm::dvec3 sun = glm::normalize(sun_in);
     SurfaceLight out;
     const glm::dvec3 delta = surface - observer;
