@@ -60,7 +60,7 @@ void add_sky_render(CLI::App& group) {
         ->capture_default_str();
     sub->add_option("--tone", o->tone, "PNG only: tone curve, aces, reinhard or clamp")->capture_default_str();
     sub->add_flag("--no-sun", o->no_sun, "Do not draw the sun disc");
-    sub->add_option("--ground", o->ground, "Ground model: lambert (physical) or seed (the seed's b-scaled term)")
+    sub->add_option("--ground", o->ground, "Ground model: lambert (physical) or as-published (Pietras & Rudnicki's b-scaled term; also: seed)")
         ->capture_default_str();
     add_json_flag(*sub, o->json);
     sub->callback([o, sub] {
@@ -89,9 +89,9 @@ void add_sky_render(CLI::App& group) {
                                  "--device cuda");
         }
         o->s.sun_disc = !o->no_sun;
-        if (o->ground != "lambert" && o->ground != "seed")
-            throw UsageError("unknown ground model '" + o->ground + "'; use lambert or seed", "--ground");
-        o->s.seed_ground = o->ground == "seed";
+        if (o->ground != "lambert" && o->ground != "as-published" && o->ground != "seed")
+            throw UsageError("unknown ground model '" + o->ground + "'; use lambert or as-published", "--ground");
+        o->s.published_ground = o->ground != "lambert";
         ToneMap tm;
         tm.curve = parse_flag("--tone", [&] { return parse_tone_curve(o->tone); });
         if (lower_extension(o->output) == ".exr")

@@ -28,7 +28,8 @@ void require_cuda_device(const std::string& where);
 // Where batch work runs.
 enum class Device : int { Cpu = 0, Cuda = 1 };
 // "cpu" or "cuda"; throws skybake::Error naming `where` otherwise.
-Device parse_device(const std::string& name, const std::string& where = "--device");
+Device parse_device(const std::string& name, const std::string& where = "device");
+const char* device_name(Device device); // "cpu", "cuda"
 
 // Limits the worker threads used by parallel loops; 0 restores the default
 // (all hardware threads). Results do not depend on the thread count.

@@ -318,11 +318,11 @@ struct SkyRenderSettings {
     int width = 512, height = 512;
     SkyMethod method = SkyMethod::Tables;
     bool sun_disc = true;           // add the attenuated sun disc
-    // false: Lambertian ground, radiance C cos θ / π (physical). true: the
-    // seed's printed surface term, that radiance times Σ_k b_k ρ_k at the
+    // false: Lambertian ground, radiance C cos θ / π (physical). true:
+    // Pietras & Rudnicki's printed surface term, that radiance times Σ_k b_k ρ_k at the
     // ground (per km): it keeps the seed's thin atmospheres (r = m = 10000)
     // about as bright as their ground, as in the seed's images.
-    bool seed_ground = false;
+    bool published_ground = false;
 };
 
 // Linear radiance per pixel (times the atmosphere's sun irradiance): the sky,

@@ -2,6 +2,7 @@
 
 #include "skybake/core.h"
 #include "skybake/error.h"
+#include "skybake/names.h"
 
 namespace skybake {
 
@@ -34,13 +35,15 @@ void require_cuda_device(const std::string& where) {
         throw Error("no usable CUDA device (" + cuda_device_problem() + "); use the CPU instead", where);
 }
 
+namespace {
+constexpr NamedValue<Device> kDeviceNames[] = {{Device::Cpu, "cpu"}, {Device::Cuda, "cuda"}};
+} // namespace
+
 Device parse_device(const std::string& name, const std::string& where) {
-    if (name == "cpu")
-        return Device::Cpu;
-    if (name == "cuda")
-        return Device::Cuda;
-    throw Error("unknown device '" + name + "'; use cpu or cuda", where);
+    return parse_name(kDeviceNames, name, "device", where);
 }
+
+const char* device_name(Device device) { return name_of(kDeviceNames, device); }
 
 void set_quiet(bool q) { g_quiet.store(q); }
 bool quiet() { return g_quiet.load(); }

@@ -11,6 +11,7 @@
 #include <tinyexr.h>
 
 #include "skybake/error.h"
+#include "skybake/names.h"
 #include "skybake/files.h"
 
 #define STB_IMAGE_WRITE_IMPLEMENTATION
@@ -43,15 +44,12 @@ void check_image(const Image& image, const fs::path& path) {
 
 } // namespace
 
-ToneCurve parse_tone_curve(const std::string& name) {
-    if (name == "clamp")
-        return ToneCurve::Clamp;
-    if (name == "reinhard")
-        return ToneCurve::Reinhard;
-    if (name == "aces")
-        return ToneCurve::Aces;
-    throw Error(fmt::format("unknown tone curve '{}'; use clamp, reinhard or aces", name));
-}
+namespace {
+constexpr NamedValue<ToneCurve> kToneCurveNames[] = {
+    {ToneCurve::Clamp, "clamp"}, {ToneCurve::Reinhard, "reinhard"}, {ToneCurve::Aces, "aces"}};
+} // namespace
+
+ToneCurve parse_tone_curve(const std::string& name) { return parse_name(kToneCurveNames, name, "tone curve", "curve"); }
 
 float tone_map_value(float linear, const ToneMap& tm) {
     if (!std::isfinite(linear) || linear <= 0.0f)

@@ -15,6 +15,7 @@
 
 #include "core/random.h"
 #include "skybake/error.h"
+#include "skybake/names.h"
 #include "skybake/mesh.h"
 
 namespace skybake {
@@ -262,39 +263,19 @@ Mesh torus(std::uint64_t target) {
     return std::move(b.mesh);
 }
 
-struct KindName {
-    ProceduralKind kind;
-    const char* name;
-};
-constexpr KindName kKinds[] = {{ProceduralKind::Sphere, "sphere"}, {ProceduralKind::Terrain, "terrain"},
-                               {ProceduralKind::City, "city"},     {ProceduralKind::Bowl, "bowl"},
-                               {ProceduralKind::Wall, "wall"},     {ProceduralKind::Torus, "torus"}};
+constexpr NamedValue<ProceduralKind> kKinds[] = {
+    {ProceduralKind::Sphere, "sphere"}, {ProceduralKind::Terrain, "terrain"}, {ProceduralKind::City, "city"},
+    {ProceduralKind::Bowl, "bowl"},     {ProceduralKind::Wall, "wall"},       {ProceduralKind::Torus, "torus"}};
 
 } // namespace
 
 ProceduralKind parse_procedural_kind(const std::string& name) {
-    for (const auto& k : kKinds)
-        if (name == k.name)
-            return k.kind;
-    std::string all;
-    for (const auto& k : kKinds)
-        all += std::string(all.empty() ? "" : ", ") + k.name;
-    throw Error(fmt::format("unknown mesh kind '{}'; choose one of {}", name, all), "kind");
+    return parse_name(kKinds, name, "mesh kind", "kind");
 }
 
-const char* procedural_kind_name(ProceduralKind kind) {
-    for (const auto& k : kKinds)
-        if (k.kind == kind)
-            return k.name;
-    return "?";
-}
+const char* procedural_kind_name(ProceduralKind kind) { return name_of(kKinds, kind); }
 
-std::vector<std::string> procedural_kind_names() {
-    std::vector<std::string> names;
-    for (const auto& k : kKinds)
-        names.emplace_back(k.name);
-    return names;
-}
+std::vector<std::string> procedural_kind_names() { return names_of(kKinds); }
 
 Mesh generate_mesh(const ProceduralOptions& o) {
     constexpr std::uint64_t kMax = 50'000'000;

@@ -36,7 +36,7 @@ SKYBAKE_HD_INLINE glm::vec3 shade_ray_neural(const sky::RenderHD& p, const MlpHD
             c = glm::max(c - neural_sky(net, glm::dot(n, d), o.cvs, cos_sun, 1.0f), glm::vec3(0.0f));
         if (cos_sun > 0.0f) {
             glm::vec3 reflected = p.albedo * (cos_sun / sky::kPi) * sky::sun_transmittance(a, a.R0, 0.0f, cos_sun);
-            if (p.seed_ground) {
+            if (p.published_ground) {
                 glm::vec3 bs(0.0f);
                 for (int k = 0; k < a.count; ++k)
                     bs += a.comp[k].sca * sky::component_density(a.comp[k], 0.0f);

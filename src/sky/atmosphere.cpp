@@ -55,23 +55,16 @@ TableRule parse_table_rule(const std::string& text, const std::string& where) {
 
 namespace {
 
-const char* profile_name(DensityProfile p) {
-    switch (p) {
-    case DensityProfile::Exponential:
-        return "exponential";
-    case DensityProfile::Tent:
-        return "tent";
-    case DensityProfile::Constant:
-        return "constant";
-    }
-    return "exponential";
-}
+constexpr NamedValue<DensityProfile> kProfileNames[] = {
+    {DensityProfile::Exponential, "exponential"},
+    {DensityProfile::Tent, "tent"},
+    {DensityProfile::Constant, "constant"},
+};
+
+const char* profile_name(DensityProfile p) { return name_of(kProfileNames, p); }
 
 DensityProfile parse_profile(const std::string& s, const std::string& where) {
-    for (DensityProfile p : {DensityProfile::Exponential, DensityProfile::Tent, DensityProfile::Constant})
-        if (s == profile_name(p))
-            return p;
-    throw Error(fmt::format("unknown density profile '{}'; use exponential, tent or constant", s), where);
+    return parse_name(kProfileNames, s, "density profile", where);
 }
 
 json vec_json(const glm::dvec3& v) { return json::array({v.x, v.y, v.z}); }

@@ -35,7 +35,7 @@ glm::dvec3 shade_ray_exact(const Atmosphere& atm, const sky::RenderHD& p, const 
         if (cos_sun > 0.0) {
             glm::dvec3 r = glm::dvec3(p.albedo) * (cos_sun / 3.14159265358979323846) *
                            sky::sun_transmittance_exact(atm, g, sun) * t;
-            if (p.seed_ground) {
+            if (p.published_ground) {
                 glm::dvec3 b(0.0);
                 for (const AtmosphereComponent& k : atm.components)
                     b += k.scattering_per_km * relative_density(k, 0.0);
@@ -86,7 +86,7 @@ RenderHD make_render_hd(const SkyModel& model, const SkyRenderSettings& s) {
     p.steps = model.options().steps;
     p.spacing = model.options().uniform_steps ? sky::kStepsUniform : sky::kStepsGraded;
     p.albedo = glm::vec3(atm.ground_albedo);
-    p.seed_ground = s.seed_ground ? 1 : 0;
+    p.published_ground = s.published_ground ? 1 : 0;
     p.irradiance = glm::vec3(atm.sun_irradiance);
     p.sun_cos_radius = float(std::cos(atm.sun_angular_radius_rad));
     p.sun_disc_radiance =

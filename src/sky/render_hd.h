@@ -28,7 +28,7 @@ struct RenderHD {
     int steps = 16;
     int spacing = kStepsGraded;
     glm::vec3 albedo{0.1f};
-    int seed_ground = 0; // 1: the seed's printed surface term, scaled by Σ b_k ρ_k (see surface.cpp)
+    int published_ground = 0; // 1: the seed's printed surface term, scaled by Σ b_k ρ_k (see surface.cpp)
     glm::vec3 irradiance{1.0f};
     float sun_cos_radius = 1.0f; // cos of the sun's angular radius
     float sun_disc_radiance = 0.0f; // 1/(π θ²) per unit irradiance; 0 hides the disc
@@ -84,7 +84,7 @@ SKYBAKE_HD_INLINE glm::vec3 shade_ray(const RenderHD& p, const glm::vec3& d) {
         const float cos_sun = glm::dot(n, p.sun);
         if (cos_sun > 0.0f) {
             glm::vec3 reflected = p.albedo * (cos_sun / kPi) * sun_transmittance(a, a.R0, 0.0f, cos_sun);
-            if (p.seed_ground) {
+            if (p.published_ground) {
                 glm::vec3 b(0.0f);
                 for (int k = 0; k < a.count; ++k)
                     b += a.comp[k].sca * component_density(a.comp[k], 0.0f);

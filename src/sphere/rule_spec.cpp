@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "skybake/error.h"
+#include "skybake/names.h"
 #include "skybake/sphere.h"
 
 namespace skybake {
@@ -70,16 +71,14 @@ std::string lebedev_list() {
 
 } // namespace
 
-const char* rule_kind_name(RuleKind kind) {
-    switch (kind) {
-    case RuleKind::MonteCarlo: return "mc";
-    case RuleKind::Fibonacci: return "fibonacci";
-    case RuleKind::Lebedev: return "lebedev";
-    case RuleKind::Design: return "design";
-    case RuleKind::Phong: return "phong";
-    }
-    return "?";
-}
+namespace {
+constexpr NamedValue<RuleKind> kRuleKindNames[] = {
+    {RuleKind::MonteCarlo, "mc"}, {RuleKind::Fibonacci, "fibonacci"}, {RuleKind::Lebedev, "lebedev"},
+    {RuleKind::Design, "design"}, {RuleKind::Phong, "phong"},
+};
+} // namespace
+
+const char* rule_kind_name(RuleKind kind) { return name_of(kRuleKindNames, kind); }
 
 std::string RuleSpec::canonical() const {
     std::string s;
