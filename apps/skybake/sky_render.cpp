@@ -5,6 +5,7 @@
 
 #include "commands.h"
 #include "flags.h"
+#include "gl_flags.h"
 #include "sky_common.h"
 
 namespace skybake::cli {
@@ -22,6 +23,8 @@ void add_sky_render(CLI::App& group) {
         int steps = 16;
         std::string ground = "lambert";
         std::string device = "cpu";
+        std::string renderer = "cpu";
+        GlRenderFlags gl;
     };
     auto o = std::make_shared<Opts>();
     o->atm.add(*sub);
@@ -61,6 +64,10 @@ void add_sky_render(CLI::App& group) {
     sub->add_flag("--no-sun", o->no_sun, "Do not draw the sun disc");
     sub->add_option("--ground", o->ground, "Ground model: lambert (physical) or seed (the seed's b-scaled term)")
         ->capture_default_str();
+    sub->add_option("--renderer", o->renderer,
+                    "cpu (the per-pixel renderer) or gl (the OpenGL planet renderer; camera views)")
+        ->capture_default_str();
+    o->gl.add(*sub, false);
     add_json_flag(*sub, o->json);
     sub->callback([o, sub] {
         check_output_path(o->output, {".png", ".exr"}, "--output");
@@ -96,6 +103,18 @@ void add_sky_render(CLI::App& group) {
         if (lower_extension(o->output) == ".exr")
             for (const char* f : {"--exposure", "--tone"})
                 refuse_if_given(*sub, f, "to an .exr output (linear radiance)");
+        const bool gl = o->renderer == "gl";
+        if (!gl && o->renderer != "cpu")
+            throw UsageError("unknown renderer '" + o->renderer + "'; use cpu or gl", "--renderer");
+        if (gl && o->s.view != SkyView::Camera)
+            throw UsageError("the OpenGL renderer draws camera views only; use --view camera", "--renderer gl");
+        if (gl && (o->s.method == SkyMethod::Exact || device == Device::Cuda))
+            throw UsageError("the OpenGL renderer uses the tables; drop --method exact and --device cuda",
+                             "--renderer gl");
+        if (!gl)
+            o->gl.refuse(*sub, "to --renderer cpu (OpenGL only)");
+        const PlanetRenderOptions gl_options =
+            o->gl.options(neural ? SkySource::Network : SkySource::Reference);
         if (device == Device::Cuda)
             require_cuda_device("--device cuda");
         SkyModelOptions opts;
@@ -103,8 +122,9 @@ void add_sky_render(CLI::App& group) {
         const auto t0 = std::chrono::steady_clock::now();
         const SkyModel model = neural ? neural_reference_model(net) : SkyModel(atm, opts);
         const bool gpu = device == Device::Cuda;
-        const Image img = neural ? (gpu ? render_neural_sky_cuda(net, model, o->s) : render_neural_sky(net, model, o->s))
-                                 : (gpu ? render_sky_cuda(model, o->s) : render_sky(model, o->s));
+        const Image img = gl       ? render_sky_gl(model, neural ? &net : nullptr, o->s, gl_options)
+                          : neural ? (gpu ? render_neural_sky_cuda(net, model, o->s) : render_neural_sky(net, model, o->s))
+                                   : (gpu ? render_sky_cuda(model, o->s) : render_sky(model, o->s));
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         tm.exposure_ev = o->exposure == "auto" ? float(auto_exposure_ev(img)) : std::stof(o->exposure);
         save_image(o->output, img, tm);
@@ -121,6 +141,7 @@ void add_sky_render(CLI::App& group) {
                         {"model", o->model.path},
                         {"ground", o->ground},
                         {"device", o->device},
+                        {"renderer", o->renderer},
                         {"exposure_ev", tm.exposure_ev},
                         {"seconds", seconds},
                         {"output", o->output}});

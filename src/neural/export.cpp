@@ -103,8 +103,12 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const E
     const std::size_t n_weights = net.weights.size();
     std::ostringstream o;
     const char* lang_name[] = {"GLSL", "HLSL", "CUDA", "C"};
-    o << fmt::format("// {}: neural sky (skybake), {} network, {} weights, trained on atmosphere \"{}\".\n", name,
-                     net.topology.name(), net.topology.weight_count(), net.atmosphere.name);
+    if (ubo) // the text must not depend on the weights or what they were trained on
+        o << fmt::format("// {}: neural sky (skybake), {} network, {} weights in a uniform block.\n", name,
+                         net.topology.name(), net.topology.weight_count());
+    else
+        o << fmt::format("// {}: neural sky (skybake), {} network, {} weights, trained on atmosphere \"{}\".\n", name,
+                         net.topology.name(), net.topology.weight_count(), net.atmosphere.name);
     o << "// Pietras & Rudnicki, \"GPU-based multi-layer perceptron as efficient method for approximation\n"
          "// complex light models in per-vertex lighting\": the sky colour I(cos a0, cos b0, cos t0, rho0).\n";
     o << "// Inputs: cos_view_zenith = V.U, cos_view_sun = V.L, cos_sun_zenith = U.L (V: view direction,\n"

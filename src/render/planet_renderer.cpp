@@ -154,6 +154,21 @@ PlanetScene::PlanetScene(const GlContext& context, const SkyModel& model, const 
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, dome_ibo_.get());
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(dome_tris.size() * 4), dome_tris.data(), GL_STATIC_DRAW);
 
+    // The top-of-atmosphere shell for observers outside the atmosphere.
+    std::vector<std::uint32_t> shell_tris;
+    for (const glm::vec3& d : icosphere_directions(6, shell_tris))
+        shell_dirs_.push_back(glm::normalize(glm::dvec3(d)));
+    shell_count_ = GLsizei(shell_tris.size());
+    shell_vao_ = make_vertex_array();
+    shell_vbo_ = make_buffer();
+    shell_ibo_ = make_buffer();
+    glBindVertexArray(shell_vao_.get());
+    glBindBuffer(GL_ARRAY_BUFFER, shell_vbo_.get());
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, shell_ibo_.get());
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(shell_tris.size() * 4), shell_tris.data(), GL_STATIC_DRAW);
+
     mesh_vao_ = make_vertex_array();
     pos_vbo_ = make_buffer();
     nrm_vbo_ = make_buffer();
@@ -242,7 +257,7 @@ PlanetScene::Basis PlanetScene::basis(const PlanetView& v) const {
         view[i][2] = -b.forward[i];
     }
     // Reversed-Z, infinite far plane: depth = near / distance along the view axis.
-    const float near_km = 1e-5f;
+    const float near_km = 1e-7f; // 0.1 mm: the ground 1 cm below the eye stays in view
     glm::mat4 proj(0.0f);
     proj[0][0] = sx;
     proj[1][1] = sy;
@@ -263,12 +278,22 @@ PlanetCamera PlanetScene::clod_camera(const PlanetView& v, const Basis& b) const
     return c;
 }
 
+glm::dvec3 PlanetScene::geometric_eye(const PlanetView& v) const {
+    // An eye exactly on the ground (altitude 0, the seed's sea level) would sit
+    // on a vertex or in the plane of the triangles around it: the mesh is
+    // drawn from 1 cm above (the shading keeps the true altitude).
+    const double r = glm::length(v.eye_km), lowest = model_.atmosphere().planet_radius_km + 1e-5;
+    return r < lowest ? v.eye_km * (lowest / r) : v.eye_km;
+}
+
 void PlanetScene::update_mesh(const PlanetView& v, PlanetFrameStats* stats) {
     const auto t0 = std::chrono::steady_clock::now();
     const Basis b = basis(v);
-    const ClodStats st = mesh_.update(clod_camera(v, b));
+    PlanetCamera cam = clod_camera(v, b);
+    cam.position_km = geometric_eye(v);
+    const ClodStats st = mesh_.update(cam);
     mesh_.indices(indices_);
-    mesh_.vertices(v.eye_km, positions_, normals_);
+    mesh_.vertices(cam.position_km, positions_, normals_);
     glBindBuffer(GL_ARRAY_BUFFER, pos_vbo_.get());
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(positions_.size() * 4), positions_.data(), GL_STREAM_DRAW);
     glBindBuffer(GL_ARRAY_BUFFER, nrm_vbo_.get());
@@ -303,10 +328,29 @@ void PlanetScene::draw(const PlanetView& v, bool flat, PlanetFrameStats* stats) 
             glBindVertexArray(empty_vao_.get());
             glDrawArrays(GL_TRIANGLES, 0, 3);
             sky_tris = 1;
-        } else {
+        } else if (glm::length(v.eye_km) <= model_.atmosphere().top_radius_km) {
+            glUniform1i(loc(sky_.get(), "u_shell"), 0);
             glBindVertexArray(dome_vao_.get());
             glDrawElements(GL_TRIANGLES, dome_count_, GL_UNSIGNED_INT, nullptr);
             sky_tris = std::size_t(dome_count_ / 3);
+        } else {
+            const double top = model_.atmosphere().top_radius_km;
+            shell_rel_.resize(shell_dirs_.size() * 3);
+            for (std::size_t i = 0; i < shell_dirs_.size(); ++i) {
+                const glm::dvec3 p = shell_dirs_[i] * top - geometric_eye(v);
+                shell_rel_[3 * i] = float(p.x);
+                shell_rel_[3 * i + 1] = float(p.y);
+                shell_rel_[3 * i + 2] = float(p.z);
+            }
+            glBindBuffer(GL_ARRAY_BUFFER, shell_vbo_.get());
+            glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(shell_rel_.size() * 4), shell_rel_.data(), GL_STREAM_DRAW);
+            glUniform1i(loc(sky_.get(), "u_shell"), 1);
+            glEnable(GL_CULL_FACE); // the near half of the shell
+            glCullFace(GL_BACK);
+            glFrontFace(GL_CCW);
+            glBindVertexArray(shell_vao_.get());
+            glDrawElements(GL_TRIANGLES, shell_count_, GL_UNSIGNED_INT, nullptr);
+            sky_tris = std::size_t(shell_count_ / 3);
         }
     }
     glEnable(GL_DEPTH_TEST);

@@ -35,6 +35,7 @@ private:
     };
     Basis basis(const PlanetView& v) const;
     PlanetCamera clod_camera(const PlanetView& v, const Basis& b) const;
+    glm::dvec3 geometric_eye(const PlanetView& v) const;
     void set_uniforms(GLuint program, const PlanetView& v, const Basis& b) const;
 
     PlanetRenderOptions options_;
@@ -47,7 +48,11 @@ private:
     int rows_ = 0, cols_ = 0;
     VertexArray empty_vao_, dome_vao_, mesh_vao_;
     Buffer dome_vbo_, dome_ibo_, pos_vbo_, nrm_vbo_, mesh_ibo_;
-    GLsizei dome_count_ = 0, mesh_count_ = 0;
+    VertexArray shell_vao_;
+    Buffer shell_vbo_, shell_ibo_;
+    std::vector<glm::dvec3> shell_dirs_; // unit directions of the top-of-atmosphere shell
+    std::vector<float> shell_rel_;       // its vertices relative to the eye, km
+    GLsizei dome_count_ = 0, mesh_count_ = 0, shell_count_ = 0;
     std::vector<std::uint32_t> indices_;
     std::vector<float> positions_, normals_;
 };

@@ -27,17 +27,35 @@ void main() {
     gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
 }
 #else
-layout(location = 0) in vec3 a_dir;
+// Per vertex, two shells. Inside the atmosphere: a sphere of directions
+// around the eye (a_pos is a unit direction); directions that meet the
+// ground take the sky's colour just above the horizon, since the planet mesh
+// covers them. Outside: the top of the atmosphere as a mesh (a_pos relative
+// to the eye, km), whose vertices crowd where it is seen edge-on, at the limb.
+uniform int u_shell;
+layout(location = 0) in vec3 a_pos;
 out vec3 v_dir;
 out vec3 v_colour;
 out vec3 v_sun_t;
 void main() {
-    vec3 d = normalize(a_dir);
+    vec3 d = normalize(a_pos);
     v_dir = d;
+    vec3 ds = d;
+    if (u_shell == 0) {
+        float cos_h = -sqrt(max(0.0, 1.0 - (u_R0 / u_eye_r) * (u_R0 / u_eye_r)));
+        float cz = dot(d, u_up);
+        if (cz < cos_h + 1e-4) {
+            vec3 hz = d - cz * u_up;
+            float lh = length(hz);
+            hz = lh > 1e-6 ? hz / lh : normalize(cross(u_up, vec3(0.3, 0.5, 0.8)));
+            float c = cos_h + 1e-4;
+            ds = c * u_up + sqrt(max(0.0, 1.0 - c * c)) * hz;
+        }
+    }
     vec3 sun_t;
-    v_colour = sb_shade_ray(d, sun_t);
+    v_colour = sb_shade_ray(ds, sun_t);
     v_sun_t = sun_t;
-    vec4 c = u_view_proj * vec4(d, 0.0);
+    vec4 c = u_view_proj * vec4(a_pos, u_shell == 0 ? 0.0 : 1.0);
     gl_Position = vec4(c.xy, 0.0, c.w);
 }
 #endif
