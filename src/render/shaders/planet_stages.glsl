@@ -28,10 +28,11 @@ void main() {
 }
 #else
 // Per vertex, two shells. Inside the atmosphere: a sphere of directions
-// around the eye (a_pos is a unit direction); directions that meet the
-// ground take the sky's colour just above the horizon, since the planet mesh
-// covers them. Outside: the top of the atmosphere as a mesh (a_pos relative
-// to the eye, km), whose vertices crowd where it is seen edge-on, at the limb.
+// around the eye (a_pos is a unit direction). Outside: the top of the
+// atmosphere as a mesh (a_pos relative to the eye, km), whose vertices crowd
+// where it is seen edge-on, at the limb. In both, directions that meet the
+// ground take the sky's colour just above the horizon (the limb): the planet
+// mesh covers them, and ground colours would bleed past its edge.
 uniform int u_shell;
 layout(location = 0) in vec3 a_pos;
 out vec3 v_dir;
@@ -41,7 +42,7 @@ void main() {
     vec3 d = normalize(a_pos);
     v_dir = d;
     vec3 ds = d;
-    if (u_shell == 0) {
+    {
         float cos_h = -sqrt(max(0.0, 1.0 - (u_R0 / u_eye_r) * (u_R0 / u_eye_r)));
         float cz = dot(d, u_up);
         if (cz < cos_h + 1e-4) {
