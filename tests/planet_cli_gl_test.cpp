@@ -139,6 +139,13 @@ TEST(PlanetCli, GlReferenceSumMatchesCpu) {
     }
 }
 
+std::size_t files_in_count(const std::string& dir) {
+    std::size_t n = 0;
+    for ([[maybe_unused]] const auto& e : fs::directory_iterator(dir))
+        ++n;
+    return n;
+}
+
 void expect_one_line_failure(const test::CliResult& r, const std::string& out, const std::string& needle) {
     EXPECT_EQ(r.exit_code, 1) << r.err;
     EXPECT_EQ(r.err_lines(), 1) << r.err;
@@ -178,6 +185,40 @@ TEST(PlanetCli, CorruptWeightsFileIsOneLine) {
     args[3] = dir + "/w.json";
     args.insert(args.end(), {"--renderer", "gl"});
     expect_one_line_failure(run_cli(args), out, "w.json");
+}
+
+TEST(PlanetCli, FlyWritesEveryFrame) {
+    const std::string dir = test::temp_dir("planet_fly");
+    const auto r = run_cli({"fly", "--model", kData + "sky_paper.json", "--frames", "4", "--size", "64x48", "-o", dir,
+                            "--shading", "pixel", "--json", "-q"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    for (int i = 0; i < 4; ++i) {
+        const std::string f = dir + "/frame_000" + std::to_string(i) + ".png";
+        ASSERT_TRUE(fs::exists(f)) << f;
+        const Image img = load_image(f);
+        EXPECT_EQ(img.width, 64);
+        double sum = 0.0;
+        for (float v : img.rgb)
+            sum += v;
+        EXPECT_GT(sum, 1.0) << "frame " << i << " is black";
+    }
+    EXPECT_EQ(files_in_count(dir), 4u);
+    EXPECT_NE(r.out.find("\"frames\": 4"), std::string::npos) << r.out;
+}
+
+TEST(PlanetCli, FlyBadPathFileIsOneLineAndNoFrames) {
+    const std::string dir = test::temp_dir("planet_fly_bad");
+    {
+        std::ofstream f(dir + "/path.json");
+        f << R"({"keyframes": [{"t": 0, "altitude_km": 1}, {"t": 0.5, "altitude_km": -3}]})";
+    }
+    const std::string out = test::temp_dir("planet_fly_bad_out");
+    const auto r = run_cli({"fly", "--model", kData + "sky_paper.json", "--frames", "3", "--size", "32x24", "-o", out,
+                            "--path", dir + "/path.json"});
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(r.err_lines(), 1) << r.err;
+    EXPECT_NE(r.err.find("keyframe 1"), std::string::npos) << r.err;
+    EXPECT_EQ(files_in_count(out), 0u);
 }
 
 TEST(PlanetCli, GlRefusesWhatItCannotDraw) {

@@ -127,7 +127,7 @@ void add_fly(CLI::App& sub) {
     sub.description("Render PNG frames of a flight from sea level to space with the OpenGL planet renderer");
     struct Opts {
         ModelFlag model;
-        std::string path = "sea-to-space", output, size = "640x480", exposure = "auto", sky = "network", mp4;
+        std::string path = "sea-to-space", output, size = "640x480", exposure = "auto", sky = "network", mp4, strip;
         int frames = 60;
         int fps = 30;
         bool json = false;
@@ -150,6 +150,7 @@ void add_fly(CLI::App& sub) {
         ->check(auto_or_real_in(-64.0, 64.0, "stops"))
         ->capture_default_str();
     sub.add_option("--mp4", o->mp4, "Also join the frames into this MP4 with ffmpeg (when installed)");
+    sub.add_option("--strip", o->strip, "Also write every frame side by side into one PNG");
     sub.add_option("--fps", o->fps, "Frame rate of the MP4")->check(integer_in(1, 240))->capture_default_str();
     sub.add_option("--ground", o->ground, "Ground model: lambert (physical) or seed (the seed's b-scaled term)")
         ->capture_default_str();
@@ -165,6 +166,8 @@ void add_fly(CLI::App& sub) {
             throw UsageError("unknown sky '" + o->sky + "'; use network or reference", "--sky");
         if (o->mp4.empty())
             refuse_if_given(sub, "--fps", "without --mp4");
+        if (!o->strip.empty())
+            check_output_path(o->strip, {".png"}, "--strip");
         std::string ffmpeg;
         if (!o->mp4.empty()) {
             check_output_path(o->mp4, {".mp4"}, "--mp4");
@@ -184,6 +187,10 @@ void add_fly(CLI::App& sub) {
         PlanetRenderer renderer(model, &net, options);
         OutputSet files;
         std::vector<fs::path> staged_frames;
+        std::vector<std::uint8_t> strip;
+        const std::size_t strip_w = std::size_t(w) * std::size_t(o->frames);
+        if (!o->strip.empty())
+            strip.resize(strip_w * std::size_t(h) * 3);
         Progress progress("fly", std::uint64_t(o->frames));
         double max_tris = 0;
         for (int i = 0; i < o->frames; ++i) {
@@ -205,10 +212,18 @@ void add_fly(CLI::App& sub) {
             tm.exposure_ev = o->exposure == "auto" ? float(auto_exposure_ev(img)) : std::stof(o->exposure);
             staged_frames.push_back(files.stage(fs::path(o->output) / fmt::format("frame_{:04d}.png", i)));
             save_png(staged_frames.back(), img, tm);
+            if (!strip.empty()) {
+                const std::vector<std::uint8_t> px = to_srgb8(img, tm);
+                for (int y = 0; y < h; ++y)
+                    std::copy_n(px.data() + std::size_t(y) * std::size_t(w) * 3, std::size_t(w) * 3,
+                                strip.data() + (std::size_t(y) * strip_w + std::size_t(i) * std::size_t(w)) * 3);
+            }
             check_interrupted();
             progress.advance();
         }
         progress.finish();
+        if (!strip.empty())
+            save_png_srgb8(files.stage(o->strip), int(strip_w), h, strip.data());
         if (!ffmpeg.empty()) {
             const fs::path staged = files.stage(o->mp4);
             // The staged frames carry staging names: link them under a pattern ffmpeg reads.
@@ -240,7 +255,8 @@ void add_fly(CLI::App& sub) {
                         {"max_triangles_used", max_tris},
                         {"seconds", seconds},
                         {"output", o->output},
-                        {"mp4", o->mp4}});
+                        {"mp4", o->mp4},
+                        {"strip", o->strip}});
     });
 }
 

@@ -118,7 +118,12 @@ vec3 sb_ground(vec3 rel, vec3 nrm) {
 }
 void main() {
 #ifdef SKYBAKE_PER_PIXEL
-    o_colour = vec4(sb_ground(v_rel, v_normal) * u_irradiance, 1.0);
+    // Smooth planet: the ray meets the sphere itself just before the inscribed
+    // mesh; shading that point (as the CPU renderer does) keeps grazing rays
+    // at the limb from seeing a chord's slightly different angles.
+    vec3 sun_t;
+    vec3 c = u_relief != 0 ? sb_ground(v_rel, v_normal) : sb_shade_ray(normalize(v_rel), sun_t);
+    o_colour = vec4(c * u_irradiance, 1.0);
 #else
     o_colour = vec4(v_colour * u_irradiance, 1.0);
 #endif
