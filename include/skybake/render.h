@@ -46,7 +46,11 @@ struct PlanetRenderOptions {
     double max_error_px = 1.0;             // CLOD screen-space error, pixels
     std::size_t max_triangles = 2'000'000; // CLOD budget
     PlanetRelief relief;                   // amplitude 0: the smooth sphere
-    int sky_shell_level = 4; // sky shell: icosahedron subdivided this often (20·4^level triangles), 0 to 7
+    // Per vertex, inside the atmosphere: a dome of view directions around the
+    // eye, 3·2^level azimuths and rings of constant angle to the horizon (one
+    // on it, crowding near it); level 0 to 7. Outside the atmosphere: the top
+    // of the atmosphere as a mesh (the icosahedron subdivided 6 times).
+    int sky_shell_level = 5;
     bool sun_disc = true;
     bool seed_ground = false; // as SkyRenderSettings::seed_ground
 };

@@ -140,15 +140,35 @@ PlanetScene::PlanetScene(const GlContext& context, const SkyModel& model, const 
 
     // Sky shell directions (per vertex) and the mesh buffers.
     empty_vao_ = make_vertex_array();
-    dome_vao_ = make_vertex_array();
+    // Sky dome (per vertex, inside the atmosphere): rings of constant angle to
+    // the horizon around the local vertical, rebuilt for each view, so that
+    // one ring lies on the horizon and the rings crowd near it, where the sky
+    // changes fastest; the triangles never straddle the horizon.
+    const int az = 3 << std::min(options.sky_shell_level, 7); // 96 at level 5
+    // Degrees above the horizon: geometric from 0.05° until the steps reach
+    // the azimuthal spacing, then uniform (square cells) up to 180°.
+    const double step = 360.0 / double(az);
+    std::vector<double> offsets = {0.0};
+    for (double e = 0.05; e < 180.0;) {
+        offsets.push_back(e);
+        e = e * 1.5 < e + step ? e * 1.5 : e + step;
+    }
+    offsets.push_back(180.0);
+    dome_rings_ = offsets;
+    dome_azimuths_ = az;
     std::vector<std::uint32_t> dome_tris;
-    const std::vector<glm::vec3> dirs = icosphere_directions(options.sky_shell_level, dome_tris);
+    const std::uint32_t ring_n = std::uint32_t(az + 1);
+    for (std::uint32_t r = 0; r + 1 < std::uint32_t(offsets.size()); ++r)
+        for (std::uint32_t a = 0; a < std::uint32_t(az); ++a) {
+            const std::uint32_t v00 = r * ring_n + a, v01 = v00 + 1, v10 = v00 + ring_n, v11 = v10 + 1;
+            dome_tris.insert(dome_tris.end(), {v00, v10, v01, v01, v10, v11});
+        }
     dome_count_ = GLsizei(dome_tris.size());
+    dome_vao_ = make_vertex_array();
     dome_vbo_ = make_buffer();
     dome_ibo_ = make_buffer();
     glBindVertexArray(dome_vao_.get());
     glBindBuffer(GL_ARRAY_BUFFER, dome_vbo_.get());
-    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(dirs.size() * sizeof(glm::vec3)), dirs.data(), GL_STATIC_DRAW);
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, dome_ibo_.get());
@@ -329,6 +349,29 @@ void PlanetScene::draw(const PlanetView& v, bool flat, PlanetFrameStats* stats) 
             glDrawArrays(GL_TRIANGLES, 0, 3);
             sky_tris = 1;
         } else if (glm::length(v.eye_km) <= model_.atmosphere().top_radius_km) {
+            // The dome's directions: from the horizon (its dip below the local
+            // horizontal) up over the zenith to the horizon on the other side.
+            const glm::dvec3 up = glm::normalize(v.eye_km);
+            const glm::dvec3 east =
+                glm::normalize(glm::cross(std::abs(up.z) < 0.9 ? glm::dvec3(0, 0, 1) : glm::dvec3(1, 0, 0), up));
+            const glm::dvec3 north = glm::cross(up, east);
+            const double R0 = model_.atmosphere().planet_radius_km, r = std::max(glm::length(v.eye_km), R0);
+            const double dip = std::acos(std::min(1.0, R0 / r)); // radians below the horizontal
+            dome_dirs_.clear();
+            for (double off : dome_rings_) {
+                // Angle from the horizon direction, over the zenith: elevation e = off − dip, up to 90°, then down the
+                // far side.
+                const double e = off * kDeg - dip;
+                for (int a = 0; a <= dome_azimuths_; ++a) {
+                    const double phi = 2.0 * 3.14159265358979323846 * double(a) / double(dome_azimuths_);
+                    const glm::dvec3 h = std::cos(phi) * east + std::sin(phi) * north;
+                    const glm::dvec3 d = std::cos(e) * h + std::sin(e) * up;
+                    dome_dirs_.push_back(glm::vec3(d));
+                }
+            }
+            glBindBuffer(GL_ARRAY_BUFFER, dome_vbo_.get());
+            glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(dome_dirs_.size() * sizeof(glm::vec3)), dome_dirs_.data(),
+                         GL_STREAM_DRAW);
             glUniform1i(loc(sky_.get(), "u_shell"), 0);
             glBindVertexArray(dome_vao_.get());
             glDrawElements(GL_TRIANGLES, dome_count_, GL_UNSIGNED_INT, nullptr);

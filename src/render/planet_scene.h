@@ -50,6 +50,9 @@ private:
     Buffer dome_vbo_, dome_ibo_, pos_vbo_, nrm_vbo_, mesh_ibo_;
     VertexArray shell_vao_;
     Buffer shell_vbo_, shell_ibo_;
+    std::vector<double> dome_rings_; // ring angles above the horizon, degrees, 0 to 180
+    int dome_azimuths_ = 96;
+    std::vector<glm::vec3> dome_dirs_;
     std::vector<glm::dvec3> shell_dirs_; // unit directions of the top-of-atmosphere shell
     std::vector<float> shell_rel_;       // its vertices relative to the eye, km
     GLsizei dome_count_ = 0, mesh_count_ = 0, shell_count_ = 0;
