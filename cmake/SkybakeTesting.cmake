@@ -5,6 +5,8 @@
 #   *_gpu_test.cpp/cu -> label "gpu"  (tests call GTEST_SKIP() without a device)
 #   *_io_test.cpp     -> label "io" (unit tests of file I/O; also run under the
 #                        sanitizer build). `ctest -L 'unit|io'` runs both.
+#   *_gl_test.cpp     -> label "gl" (the OpenGL planet renderer and its mesh;
+#                        headless EGL, passes on Mesa llvmpipe)
 #   other *_test.cpp  -> label "unit"
 # Test names are prefixed with NAME.
 find_package(GTest REQUIRED)
@@ -12,7 +14,7 @@ include(GoogleTest)
 
 function(skybake_add_tests name)
   cmake_parse_arguments(T "" "" "FILES;LIBS" ${ARGN})
-  set(groups unit io slow gpu)
+  set(groups unit io slow gpu gl)
   foreach(g IN LISTS groups)
     set(files_${g} "")
   endforeach()
@@ -26,6 +28,8 @@ function(skybake_add_tests name)
       list(APPEND files_gpu ${f})
     elseif(f MATCHES "_io_test\\.(cpp|cu)$")
       list(APPEND files_io ${f})
+    elseif(f MATCHES "_gl_test\\.cpp$")
+      list(APPEND files_gl ${f})
     else()
       list(APPEND files_unit ${f})
     endif()

@@ -21,7 +21,7 @@ PACKAGES=(
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev glslang-tools
   # OpenGL (headless EGL and windowed GLFW)
-  libegl-dev libgl-dev libglfw3-dev libepoxy-dev libegl-mesa0
+  libegl-dev libgl-dev libglfw3-dev libepoxy-dev libegl-mesa0 libgl1-mesa-dri
   # Python bindings
   pybind11-dev python3-dev
 )

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Checks that the modules of src/ include one another in one direction only.
 
-Each module's allowed dependencies are its DEPENDS in src/CMakeLists.txt (and
-theirs, transitively). A file of src/MODULE/ - sources, headers and tests alike -
+Each module's allowed dependencies are its DEPENDS in src/CMakeLists.txt or
+src/*/*.cmake (and theirs, transitively). A file of src/MODULE/ - sources, headers and tests alike -
 may include "OTHER/..." or the public header of OTHER only when MODULE depends
 on OTHER. Prints each violation and exits 1 if there is any.
 
@@ -13,7 +13,11 @@ import re
 import sys
 
 root = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..")
+import glob
+
 cmake = open(os.path.join(root, "src", "CMakeLists.txt")).read()
+for extra in sorted(glob.glob(os.path.join(root, "src", "*", "*.cmake"))):
+    cmake += "\n" + open(extra).read()
 direct = {}
 for m in re.finditer(r"skybake_add_module\((\w+)([^)]*)\)", cmake):
     name, args = m.group(1), m.group(2)
@@ -34,7 +38,7 @@ allowed = {m: closure(m) | {m} for m in direct}
 # The public header each module owns (include/skybake/NAME.h).
 owner = {"bake.h": "bake", "visibility.h": "visibility", "sky.h": "sky", "neural.h": "neural",
          "sphere.h": "sphere", "mesh.h": "io", "image.h": "io", "sh.h": "sphere",
-         "sky_source.h": "neural"}
+         "sky_source.h": "neural", "planet.h": "planet", "render.h": "render"}
 include = re.compile(r'#\s*include\s+"(\w+)/([^"]+)"')
 violations = 0
 for module in direct:

@@ -31,6 +31,8 @@ const Group kGroups[] = {
     {"sphere", "Quadrature rules on the sphere and spherical harmonics"},
     {"ao", "Bake per-vertex ambient occlusion and shading coefficients"},
     {"prt", "Bake spherical-harmonic transfer (PRT/DPRT)"},
+    {"fly", "Render frames of a flight from sea level to space (OpenGL, headless)"},
+    {"view", "Interactive viewers (OpenGL window)"},
 };
 
 } // namespace

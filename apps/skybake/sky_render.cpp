@@ -5,6 +5,7 @@
 
 #include "commands.h"
 #include "flags.h"
+#include "gl_flags.h"
 #include "sky_common.h"
 #include "skybake/sky_source.h"
 
@@ -23,6 +24,8 @@ void add_sky_render(CLI::App& group) {
         int steps = 16;
         std::string ground = "lambert";
         std::string device = "cpu";
+        std::string renderer = "cpu";
+        GlRenderFlags gl;
     };
     auto o = std::make_shared<Opts>();
     o->atm.add(*sub);
@@ -62,6 +65,10 @@ void add_sky_render(CLI::App& group) {
     sub->add_flag("--no-sun", o->no_sun, "Do not draw the sun disc");
     sub->add_option("--ground", o->ground, "Ground model: lambert (physical) or as-published (Pietras & Rudnicki's b-scaled term; also: seed)")
         ->capture_default_str();
+    sub->add_option("--renderer", o->renderer,
+                    "cpu (the per-pixel renderer) or gl (the OpenGL planet renderer; camera views)")
+        ->capture_default_str();
+    o->gl.add(*sub, false);
     add_json_flag(*sub, o->json);
     sub->callback([o, sub] {
         check_output_path(o->output, {".png", ".exr"}, "--output");
@@ -97,12 +104,26 @@ void add_sky_render(CLI::App& group) {
         if (lower_extension(o->output) == ".exr")
             for (const char* f : {"--exposure", "--tone"})
                 refuse_if_given(*sub, f, "to an .exr output (linear radiance)");
+        const bool gl = o->renderer == "gl";
+        if (!gl && o->renderer != "cpu")
+            throw UsageError("unknown renderer '" + o->renderer + "'; use cpu or gl", "--renderer");
+        if (gl && o->s.view != SkyView::Camera)
+            throw UsageError("the OpenGL renderer draws camera views only; use --view camera", "--renderer gl");
+        if (gl && (o->s.method == SkyMethod::Exact || device == Device::Cuda))
+            throw UsageError("the OpenGL renderer uses the tables; drop --method exact and --device cuda",
+                             "--renderer gl");
+        if (!gl)
+            o->gl.refuse(*sub, "to --renderer cpu (OpenGL only)");
+        const PlanetRenderOptions gl_options = o->gl.options(neural ? PlanetSky::Network : PlanetSky::Reference);
         SkyModelOptions opts;
         opts.steps = o->steps;
         const auto t0 = std::chrono::steady_clock::now();
+        // What computes the sky, and where: one object (no GPU: exit 1 here).
         const SkySource source = neural ? SkySource::network(net, device)
                                         : SkySource::reference(SkyModel(atm, opts), o->s.method, device);
-        const Image img = source.render(o->s);
+        const Image img = gl ? render_sky_gl(source.tables(), neural ? &source.network_weights() : nullptr, o->s,
+                                             gl_options)
+                             : source.render(o->s);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         tm.exposure_ev = o->exposure == "auto" ? float(auto_exposure_ev(img)) : std::stof(o->exposure);
         save_image(o->output, img, tm);
@@ -119,6 +140,7 @@ void add_sky_render(CLI::App& group) {
                         {"model", o->model.path},
                         {"ground", o->ground},
                         {"device", o->device},
+                        {"renderer", o->renderer},
                         {"exposure_ev", tm.exposure_ev},
                         {"seconds", seconds},
                         {"output", o->output}});

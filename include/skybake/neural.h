@@ -233,6 +233,21 @@ ExportLanguage parse_export_language(std::string_view text, const std::string& w
 std::string export_neural_sky(const NeuralSky& net, ExportLanguage language,
                               const std::string& function_name = "skybake_sky");
 
+// GLSL with the weights read from a uniform block instead of constants:
+//   layout(std140) uniform BLOCK { vec4 NAME_w[K]; };
+// holding the weights in the layout above, then max{N} and log_range
+// (neural_sky_uniform_data). The text then depends only on the topology and
+// the brightness encoding, so new weights of the same kind need no new
+// shader: upload them with neural_sky_uniform_data. Other languages ignore it.
+struct ShaderExportOptions {
+    std::string function_name = "skybake_sky";
+    bool uniform_block = false;
+    std::string block_name = "SkybakeSkyWeights"; // a valid identifier
+};
+std::string export_neural_sky(const NeuralSky& net, ExportLanguage language, const ShaderExportOptions& options);
+// The contents of that uniform block: 4 * K floats (K vec4s, zero-padded).
+std::vector<float> neural_sky_uniform_data(const NeuralSky& net);
+
 // [SECTION] Accuracy -------------------------------------------------------------------------
 //
 // Relative RGB error |ΔI|/|I| (Euclidean norms over R, G, B) on held-out

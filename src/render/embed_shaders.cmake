@@ -1,0 +1,12 @@
+# cmake -DOUT=header.h -DDIR=src/render/shaders -P embed_shaders.cmake
+file(GLOB FILES ${DIR}/*.glsl)
+list(SORT FILES)
+set(text "// Generated from src/render/shaders/*.glsl; do not edit.\n#pragma once\n\nnamespace skybake::render::shaders {\n")
+foreach(f IN LISTS FILES)
+  get_filename_component(name ${f} NAME_WE)
+  file(READ ${f} body)
+  string(APPEND text "inline constexpr const char* ${name} = R\"glsl(${body})glsl\";\n")
+endforeach()
+string(APPEND text "} // namespace skybake::render::shaders\n")
+file(WRITE ${OUT}.tmp "${text}")
+file(RENAME ${OUT}.tmp ${OUT})
