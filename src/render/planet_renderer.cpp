@@ -232,10 +232,11 @@ void PlanetScene::set_uniforms(GLuint p, const PlanetView& v, const Basis& b) co
     glUniform1i(loc(p, "u_tables"), 0);
     glUniform1i(loc(p, "u_rows"), rows_);
     glUniform1i(loc(p, "u_cols"), cols_);
-    const double r = glm::length(v.eye_km);
+    const glm::dvec3 eye = shading_eye(v);
+    const double r = glm::length(eye);
     glUniform1f(loc(p, "u_eye_r"), float(r));
     glUniform1f(loc(p, "u_eye_h"), float(r - atm.planet_radius_km));
-    const glm::vec3 up(v.eye_km / r);
+    const glm::vec3 up(eye / r);
     glUniform3f(loc(p, "u_up"), up.x, up.y, up.z);
     const glm::vec3 sun = glm::normalize(glm::vec3(v.sun));
     glUniform3f(loc(p, "u_sun"), sun.x, sun.y, sun.z);
@@ -302,8 +303,17 @@ glm::dvec3 PlanetScene::geometric_eye(const PlanetView& v) const {
     // An eye exactly on the ground (altitude 0, the seed's sea level) would sit
     // on a vertex or in the plane of the triangles around it: the mesh is
     // drawn from 1 cm above (the shading keeps the true altitude).
-    const double r = glm::length(v.eye_km), lowest = model_.atmosphere().planet_radius_km + 1e-5;
+    // With relief, an eye inside the terrain is lifted to 1 m above it (for
+    // the shading too: see shading_eye).
+    const double r = glm::length(v.eye_km);
+    double lowest = model_.atmosphere().planet_radius_km + 1e-5;
+    if (options_.relief.amplitude_km > 0.0)
+        lowest += relief_height_km(options_.relief, v.eye_km / r) + 1e-3;
     return r < lowest ? v.eye_km * (lowest / r) : v.eye_km;
+}
+
+glm::dvec3 PlanetScene::shading_eye(const PlanetView& v) const {
+    return options_.relief.amplitude_km > 0.0 ? geometric_eye(v) : v.eye_km;
 }
 
 void PlanetScene::update_mesh(const PlanetView& v, PlanetFrameStats* stats) {

@@ -36,6 +36,7 @@ private:
     Basis basis(const PlanetView& v) const;
     PlanetCamera clod_camera(const PlanetView& v, const Basis& b) const;
     glm::dvec3 geometric_eye(const PlanetView& v) const;
+    glm::dvec3 shading_eye(const PlanetView& v) const;
     void set_uniforms(GLuint program, const PlanetView& v, const Basis& b) const;
 
     PlanetRenderOptions options_;
