@@ -1,4 +1,5 @@
-// skybake ao INPUT -o OUTPUT.glb|.ply [--rule R] [--device D] [--backend B] [--method M] [--max-distance D] [--offset E]
+// skybake ao INPUT -o OUTPUT.glb|.ply [--rule R] [--device D] [--backend B] [--method M] [--resolution N]
+//            [--max-distance D] [--offset E]
 //            [--back-faces occlude|ignore] [--normalize] [--bits FILE] [--preview FILE.png]
 //            [--preview-size WxH] [--json]
 #include <algorithm>
@@ -28,7 +29,8 @@ struct AoOptions {
     std::string rule = kDefaultRule;
     std::string device = "cpu";
     std::string backend; // empty: embree on the CPU, cuda on the GPU
-    std::string method = "bvh";
+    std::string method; // empty: the backend's default (bvh; cube for raster)
+    std::uint32_t resolution = 0; // raster: 0 = the method's default
     double max_distance = std::numeric_limits<double>::infinity();
     std::string offset = "auto";
     std::string back_faces = "occlude";
@@ -59,8 +61,9 @@ std::string backend_name(const AoOptions& o) {
     const Device device = parse_flag("--device", [&] { return parse_device(o.device); });
     if (o.backend.empty())
         return device == Device::Cuda ? "cuda" : "embree";
-    if (o.backend != "embree" && o.backend != "brute" && o.backend != "cuda")
-        throw UsageError(fmt::format("unknown backend '{}'; use embree, brute or cuda", o.backend), "--backend");
+    if (o.backend != "embree" && o.backend != "brute" && o.backend != "cuda" && o.backend != "raster")
+        throw UsageError(fmt::format("unknown backend '{}'; use embree, brute, cuda or raster", o.backend),
+                         "--backend");
     if (device == Device::Cuda && o.backend != "cuda")
         throw UsageError(fmt::format("--backend {} runs on the CPU, but --device is cuda", o.backend), "--backend");
     return o.backend;
@@ -75,11 +78,28 @@ void run(const AoOptions& o, const CLI::App& sub) {
                                      "design, fibonacci or mc rule for ambient occlusion",
                                      rule.spec),
                          "--rule");
-    const TraceMethod method = parse_flag("--method", [&] { return parse_trace_method(o.method); });
     const std::string backend_id = backend_name(o);
-    if (method != TraceMethod::Bvh && backend_id != "cuda")
+    const TraceMethod method = o.method.empty() ? default_trace_method(backend_id)
+                                                : parse_flag("--method", [&] { return parse_trace_method(o.method); });
+    const bool raster_method = method == TraceMethod::Cube || method == TraceMethod::Directional;
+    if (backend_id == "raster" && !raster_method)
+        throw UsageError(fmt::format("--method {} is not a raster method; use cube (default) or directional", o.method),
+                         "--method");
+    if (backend_id != "raster" && raster_method)
+        throw UsageError(fmt::format("--method {} is a method of the raster backend; add --backend raster", o.method),
+                         "--method");
+    if (method != TraceMethod::Bvh && !raster_method && backend_id != "cuda")
         throw UsageError(fmt::format("--method {} is a method of the GPU backend; add --device cuda", o.method),
                          "--method");
+    if (backend_id != "raster")
+        refuse_if_given(sub, "--resolution", "without --backend raster");
+    if (method == TraceMethod::Directional && std::isfinite(o.max_distance))
+        throw UsageError("the directional method has no maximum distance; use --method cube", "--max-distance");
+    if (method == TraceMethod::Directional && rule.rotate_per_vertex)
+        throw UsageError(fmt::format("the directional method needs one set of directions for every vertex; drop "
+                                     "+rotate from '{}', or use --method cube",
+                                     rule.spec),
+                         "--rule");
     const BackFaces back_faces = parse_flag("--back-faces", [&] { return parse_back_faces(o.back_faces); });
     AoPreviewOptions preview;
     parse_flag("--preview-size", [&] { parse_size(o.preview_size, preview.width, preview.height, "--preview-size"); });
@@ -93,7 +113,10 @@ void run(const AoOptions& o, const CLI::App& sub) {
         check_output_path(o.preview, {".png", ".exr"}, "--preview");
     if (!o.bits.empty())
         check_output_path(o.bits, {}, "--bits");
-    const auto tracer = make_visibility_tracer(backend_id, method); // no GPU: a runtime error, exit 1
+    const auto tracer = make_visibility_tracer(backend_id, method, o.resolution); // no GPU or GL: exit 1
+    const std::uint32_t resolution = o.resolution                  ? o.resolution
+                                     : method == TraceMethod::Cube ? kRasterCubeResolution
+                                                                   : kRasterDirectionalResolution;
 
     BakeOptions b;
     b.max_distance = float(o.max_distance);
@@ -123,8 +146,10 @@ void run(const AoOptions& o, const CLI::App& sub) {
                             {"output", o.output},
                             {"backend", r.backend},
                             {"method", r.method},
-                            {"device", device.empty() ? "cpu" : "cuda"},
+                            {"device", backend_id == "cuda" ? "cuda" : backend_id == "raster" ? "opengl" : "cpu"},
                             {"gpu", device.empty() ? nlohmann::json(nullptr) : nlohmann::json(device)},
+                            {"resolution", backend_id == "raster" ? nlohmann::json(resolution)
+                                                                  : nlohmann::json(nullptr)},
                             {"rule", r.rule},
                             {"directions", r.directions},
                             {"vertices", r.vertices},
@@ -153,10 +178,13 @@ void run(const AoOptions& o, const CLI::App& sub) {
         mean += a;
     mean /= double(std::max<std::size_t>(1, outputs.ao.size()));
     info("baked {} vertices ({} triangles) with {} ({} directions, {}{}{}): {} rays in {:.2f} s ({:.1f} Mrays/s), "
-         "BVH {:.2f} s",
+         "{} {:.2f} s",
          r.vertices, r.triangles, r.rule, r.directions, r.backend,
-         method == TraceMethod::Bvh ? "" : " " + r.method, device.empty() ? "" : " on " + device, r.rays, r.seconds,
-         r.rays_per_second() * 1e-6, r.build_seconds);
+         method == TraceMethod::Bvh ? ""
+         : backend_id == "raster"   ? fmt::format(" {} {}", r.method, resolution)
+                                    : " " + r.method,
+         device.empty() ? "" : " on " + device, r.rays, r.seconds, r.rays_per_second() * 1e-6,
+         backend_id == "raster" ? "mesh upload" : "BVH", r.build_seconds);
     if (r.negative_weights)
         info("note: {} has negative weights; {} vertices had sums outside [0, 1], clamped", r.rule,
              r.clamped_vertices);
@@ -181,9 +209,12 @@ void add_ao_bake(CLI::App& group) {
                     "Visibility backend: embree (CPU; the default with --device cpu), brute (test oracle, small "
                     "meshes) or cuda (the default with --device cuda)");
     sub->add_option("--method", o->method,
-                    "How the GPU backend finds blockers: bvh, per-vertex (every triangle for every ray, the seed's "
-                    "naive method) or per-polygon (every triangle, cached in shared memory)")
-        ->capture_default_str();
+                    "How blockers are found. cuda: bvh (default), per-vertex (every triangle for every ray, the "
+                    "seed's naive method) or per-polygon (every triangle, cached in shared memory); raster: cube "
+                    "(default: a depth cube map per vertex, the seed's) or directional (a depth map per direction)");
+    sub->add_option("--resolution", o->resolution,
+                    "raster: cube face or depth map size in texels (default 256 for cube, 2048 for directional)")
+        ->check(CLI::Range(8u, kRasterMaxResolution));
     sub->add_option("--max-distance", o->max_distance,
                     "Ignore occluders further than this, in mesh units (default: unlimited)")
         ->check(real_in(0.0, 1e30, "mesh units", End::Open)); // stored as a float

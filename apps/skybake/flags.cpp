@@ -160,6 +160,7 @@ std::string flag_for_field(const std::string& where) {
         {"rule", "--rule"},
         {"method", "--method"},
         {"backend", "--backend"},
+        {"resolution", "--resolution"},
         {"device", "--device cuda"},
         {"back_faces", "--back-faces"},
         {"preset", "--preset"},

@@ -24,7 +24,11 @@
 //   "cuda"    NVIDIA GPUs (builds that have CUDA, machines that have a GPU): a
 //             BVH built on the CPU with Embree's builder, walked by one GPU
 //             thread per ray. Also the seed's brute-force methods (TraceMethod)
-// Each implements both interfaces.
+//   "raster"  the depth buffer of any OpenGL 4.3 context (a GPU, or Mesa's
+//             llvmpipe): a depth cube map per vertex (the seed's method) or a
+//             depth map per direction. A VisibilityTracer only: rasterisation
+//             answers no single ray
+// The first three implement both interfaces.
 //
 // Frames and units: everything is in the mesh's world space and its own length
 // unit ("mesh units"); directions are unit vectors in the same frame.
@@ -75,15 +79,23 @@ const char* back_faces_name(BackFaces mode); // "occlude", "ignore"
 // Parses "occlude" or "ignore"; throws skybake::Error otherwise.
 BackFaces parse_back_faces(const std::string& text);
 
-// How the cuda backend finds blockers (BakeOptions::method). Every method
-// decides the same ray–triangle test on the same triangles, so all three give
-// the same bits; they differ in speed only (docs/PERFORMANCE.md).
+// How a backend finds blockers (BakeOptions::method).
+//  - The cuda backend's three methods decide the same ray–triangle test on the
+//    same triangles, so all three give the same bits; they differ in speed only
+//    (docs/PERFORMANCE.md).
+//  - The raster backend's two methods answer with the depth buffer instead of
+//    rays: they agree with the ray tracers up to texel size and depth bias
+//    (docs/baking.md).
 enum class TraceMethod : int {
-    Bvh = 0,        // "bvh": the BVH (default; the only method of the CPU backends)
-    PerVertex = 1,  // "per-vertex": the seed's naive method, every triangle for every ray
-    PerPolygon = 2, // "per-polygon": every triangle too, in tiles cached in shared memory
+    Bvh = 0,         // "bvh": the BVH (the default and only method of embree, brute; cuda's default)
+    PerVertex = 1,   // "per-vertex": cuda, the seed's naive method, every triangle for every ray
+    PerPolygon = 2,  // "per-polygon": cuda, every triangle too, in tiles cached in shared memory
+    Cube = 3,        // "cube": raster (default), the seed's depth cube map at each vertex
+    Directional = 4, // "directional": raster, one orthographic depth map per rule direction
 };
-const char* trace_method_name(TraceMethod method); // "bvh", "per-vertex", "per-polygon"
+const char* trace_method_name(TraceMethod method); // "bvh", "per-vertex", "per-polygon", "cube", "directional"
+// A backend's default method: Cube for "raster", Bvh for the others.
+TraceMethod default_trace_method(const std::string& backend);
 // Parses a name above; throws skybake::Error otherwise.
 TraceMethod parse_trace_method(const std::string& text);
 
@@ -157,12 +169,13 @@ class VisibilityTracer {
 public:
     virtual ~VisibilityTracer() = default;
 
-    // "embree", "brute", "cuda"
+    // "embree", "brute", "cuda", "raster"
     virtual const char* name() const = 0;
     // How blockers are found; TraceMethod::Bvh except for the cuda backend's
-    // brute-force methods.
+    // brute-force methods and the raster backend.
     virtual TraceMethod method() const { return TraceMethod::Bvh; }
-    // The GPU's name for a GPU tracer, empty on the CPU.
+    // The GPU's name for a GPU tracer, empty on the CPU (the raster backend:
+    // the OpenGL renderer, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)").
     virtual std::string device_name() const { return {}; }
 
     // As RayQueries::set_mesh().
@@ -182,6 +195,11 @@ public:
     // A GPU tracer's copy of the last chunk's words in device memory (same
     // layout), or nullptr: a reduction with a CUDA kernel can read them there.
     virtual const std::uint32_t* device_words() const { return nullptr; }
+    // Whether each trace() call has a fixed cost worth spreading (a GPU
+    // launch; the raster backend's depth maps of every direction): the driver
+    // then gives it the largest chunks that set_rule() and memory allow,
+    // instead of chunks sized for progress and interrupts.
+    virtual bool prefers_large_chunks() const { return device_words_supported(); }
 };
 
 // [SECTION] Backends -----------------------------------------------------------------------
@@ -191,12 +209,22 @@ public:
 std::vector<std::string> visibility_backend_names();
 
 // Create a backend by name. Throw skybake::Error (where: "backend") for an
-// unknown name, and for "cuda" in a build without CUDA or on a machine
-// without a CUDA device; make_visibility_tracer() also for a method the
-// backend does not have (where: "method").
+// unknown name, for "cuda" in a build without CUDA or on a machine without a
+// CUDA device, for "raster" without an OpenGL 4.3 context, and for "raster"
+// as RayQueries; make_visibility_tracer() also for a method the backend does
+// not have (where: "method"), and for a resolution out of range (where:
+// "resolution"). `resolution` is the raster backend's cube face or depth map
+// size in texels (0: the method's default, kRasterCubeResolution or
+// kRasterDirectionalResolution); other backends take 0 only.
 std::unique_ptr<RayQueries> make_ray_queries(const std::string& name);
 std::unique_ptr<VisibilityTracer> make_visibility_tracer(const std::string& name,
-                                                         TraceMethod method = TraceMethod::Bvh);
+                                                         TraceMethod method = TraceMethod::Bvh,
+                                                         std::uint32_t resolution = 0);
+
+// The raster backend's default resolutions, and the largest it takes.
+inline constexpr std::uint32_t kRasterCubeResolution = 256;
+inline constexpr std::uint32_t kRasterDirectionalResolution = 2048;
+inline constexpr std::uint32_t kRasterMaxResolution = 8192;
 
 // The brute-force backend refuses meshes with more triangles than this.
 inline constexpr std::size_t kBruteForceMaxTriangles = 20'000;

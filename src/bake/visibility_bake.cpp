@@ -103,10 +103,11 @@ VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, Vi
     const std::uint64_t per_vertex =
         2 * sizeof(glm::vec3) + (rotate ? sizeof(glm::mat3) : 0) + (host_words ? 4ull * words : 0);
     const auto memory_limit = std::uint32_t(std::clamp<std::uint64_t>(kChunkBytes / per_vertex, 1, 0xffffffffu));
-    // A GPU tracer takes the largest chunk it allows (fewer launches); a CPU
-    // tracer's chunks are sized for the progress bar and interrupts.
+    // A GPU or raster tracer takes the largest chunk it allows (fewer launches,
+    // fewer depth maps); a CPU tracer's chunks are sized for the progress bar
+    // and interrupts.
     const std::uint32_t wanted =
-        tracer.device_words_supported() ? tracer_limit : std::max(n / kChunksPerBake, kMinChunk);
+        tracer.prefers_large_chunks() ? tracer_limit : std::max(n / kChunksPerBake, kMinChunk);
     const std::uint32_t chunk =
         std::max<std::uint32_t>(1, std::min({wanted, tracer_limit, memory_limit, std::max(n, 1u)}));
 

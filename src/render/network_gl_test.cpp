@@ -12,12 +12,14 @@
 
 #include "neural/internal.h"
 #include "neural/mlp_hd.h"
-#include "render/gl.h"
+#include "gl/gl.h"
 #include "skybake/error.h"
 #include "skybake/neural.h"
 
 namespace skybake::render {
 namespace {
+
+using namespace skybake::gl;
 
 // A network with random weights of the seed's size or larger: the test is
 // about the arithmetic, not about the sky.

@@ -7,10 +7,12 @@
 
 #include <glm/mat4x4.hpp>
 
-#include "render/gl.h"
+#include "gl/gl.h"
 #include "skybake/render.h"
 
 namespace skybake::render {
+
+using namespace skybake::gl; // the OpenGL layer
 
 class PlanetScene {
 public:

@@ -244,13 +244,16 @@ TEST(Visibility, FactoriesRefuseWhatTheyCannotMake) {
     }
     const Mesh big = generate_mesh({ProceduralKind::Sphere, 40000, 1});
     EXPECT_THROW(make_ray_queries("brute")->set_mesh(big), Error);
-    for (TraceMethod mth : {TraceMethod::Bvh, TraceMethod::PerVertex, TraceMethod::PerPolygon})
+    for (TraceMethod mth : {TraceMethod::Bvh, TraceMethod::PerVertex, TraceMethod::PerPolygon, TraceMethod::Cube,
+                            TraceMethod::Directional})
         EXPECT_EQ(parse_trace_method(trace_method_name(mth)), mth);
     try {
         parse_trace_method("octree");
         ADD_FAILURE() << "no error";
     } catch (const Error& e) {
-        EXPECT_EQ(e.message(), "unknown method 'octree'; choose bvh (default), per-vertex (every triangle for every "
-                               "ray) or per-polygon (every triangle, cached in shared memory; cuda backend)");
+        EXPECT_EQ(e.message(), "unknown method 'octree'; choose bvh (default), per-vertex (cuda backend: every "
+                               "triangle for every ray), per-polygon (cuda backend: every triangle, cached in shared "
+                               "memory), cube (raster backend, its default: a depth cube map at each vertex) or "
+                               "directional (raster backend: a depth map per direction)");
     }
 }

@@ -26,7 +26,7 @@
 
 #include "skybake/image.h"
 
-namespace skybake::render {
+namespace skybake::gl {
 
 // [SECTION] Contexts -----------------------------------------------------------
 
@@ -40,6 +40,8 @@ public:
     int major_version() const { return major_; }
     int minor_version() const { return minor_; }
     bool has_clip_control() const { return clip_control_; }
+    // Whether the context is at least OpenGL major.minor.
+    bool at_least(int major, int minor) const { return major_ * 10 + minor_ >= major * 10 + minor; }
 
 protected:
     // Reads and checks the version of the current context (throws below 3.3 core).
@@ -103,9 +105,14 @@ VertexArray make_vertex_array();
 struct ShaderSource {
     std::vector<std::string> pieces;
 };
+struct ShaderStage {
+    GLenum stage; // GL_VERTEX_SHADER, GL_GEOMETRY_SHADER, GL_FRAGMENT_SHADER, GL_COMPUTE_SHADER
+    ShaderSource source;
+};
 // Compiles and links a program. Throws skybake::Error naming `name` with the
 // stage and the first line of the info log, e.g.
 //   "fragment shader does not compile: 0:12(5): error: `foo' undeclared (planet shader)".
+Program link_program(const std::string& name, const std::vector<ShaderStage>& stages);
 Program link_program(const std::string& name, const ShaderSource& vertex, const ShaderSource& fragment);
 
 // [SECTION] Render targets --------------------------------------------------------------
@@ -132,4 +139,4 @@ private:
 // Throws skybake::Error naming `what` if glGetError reports an error.
 void check_gl(const char* what);
 
-} // namespace skybake::render
+} // namespace skybake::gl

@@ -10,10 +10,10 @@
 #include <epoxy/egl.h>
 #include <fmt/format.h>
 
-#include "render/gl.h"
+#include "gl/gl.h"
 #include "skybake/error.h"
 
-namespace skybake::render {
+namespace skybake::gl {
 
 namespace {
 
@@ -159,4 +159,4 @@ std::unique_ptr<GlContext> create_headless_context() {
     return std::make_unique<EglContext>();
 }
 
-} // namespace skybake::render
+} // namespace skybake::gl

@@ -1,10 +1,10 @@
 // RAII wrappers, shader programs and float render targets.
 #include <fmt/format.h>
 
-#include "render/gl.h"
+#include "gl/gl.h"
 #include "skybake/error.h"
 
-namespace skybake::render {
+namespace skybake::gl {
 
 void delete_buffer(GLuint id) {
     glDeleteBuffers(1, &id);
@@ -56,6 +56,16 @@ std::string first_line(std::string log) {
     return nl == std::string::npos ? log : log.substr(0, nl);
 }
 
+const char* stage_name(GLenum stage) {
+    switch (stage) {
+    case GL_VERTEX_SHADER: return "vertex";
+    case GL_GEOMETRY_SHADER: return "geometry";
+    case GL_FRAGMENT_SHADER: return "fragment";
+    case GL_COMPUTE_SHADER: return "compute";
+    default: return "unknown";
+    }
+}
+
 GLuint compile(GLenum stage, const ShaderSource& src, const std::string& name) {
     std::vector<const char*> ptrs;
     for (const std::string& p : src.pieces)
@@ -72,8 +82,7 @@ GLuint compile(GLenum stage, const ShaderSource& src, const std::string& name) {
         glGetShaderInfoLog(s, GLsizei(log.size()), nullptr, log.data());
         glDeleteShader(s);
         log.resize(log.find('\0') == std::string::npos ? log.size() : log.find('\0'));
-        throw Error(fmt::format("{} shader does not compile: {}", stage == GL_VERTEX_SHADER ? "vertex" : "fragment",
-                                first_line(log)),
+        throw Error(fmt::format("{} shader does not compile: {}", stage_name(stage), first_line(log)),
                     name + " shader");
     }
     return s;
@@ -81,21 +90,22 @@ GLuint compile(GLenum stage, const ShaderSource& src, const std::string& name) {
 
 } // namespace
 
-Program link_program(const std::string& name, const ShaderSource& vertex, const ShaderSource& fragment) {
-    const GLuint vs = compile(GL_VERTEX_SHADER, vertex, name);
-    GLuint fs = 0;
+Program link_program(const std::string& name, const std::vector<ShaderStage>& stages) {
+    std::vector<GLuint> shaders;
     try {
-        fs = compile(GL_FRAGMENT_SHADER, fragment, name);
+        for (const ShaderStage& st : stages)
+            shaders.push_back(compile(st.stage, st.source, name));
     } catch (...) {
-        glDeleteShader(vs);
+        for (GLuint s : shaders)
+            glDeleteShader(s);
         throw;
     }
     Program p(glCreateProgram());
-    glAttachShader(p.get(), vs);
-    glAttachShader(p.get(), fs);
+    for (GLuint s : shaders)
+        glAttachShader(p.get(), s);
     glLinkProgram(p.get());
-    glDeleteShader(vs);
-    glDeleteShader(fs);
+    for (GLuint s : shaders)
+        glDeleteShader(s);
     GLint ok = 0;
     glGetProgramiv(p.get(), GL_LINK_STATUS, &ok);
     if (!ok) {
@@ -107,6 +117,10 @@ Program link_program(const std::string& name, const ShaderSource& vertex, const 
         throw Error("program does not link: " + first_line(log), name + " shader");
     }
     return p;
+}
+
+Program link_program(const std::string& name, const ShaderSource& vertex, const ShaderSource& fragment) {
+    return link_program(name, {{GL_VERTEX_SHADER, vertex}, {GL_FRAGMENT_SHADER, fragment}});
 }
 
 RenderTarget::RenderTarget(int width, int height) : width_(width), height_(height) {
@@ -160,4 +174,4 @@ Image RenderTarget::read_rgb() const {
     return img;
 }
 
-} // namespace skybake::render
+} // namespace skybake::gl

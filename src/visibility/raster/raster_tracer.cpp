@@ -1,0 +1,500 @@
+// The raster visibility backend: depth cube maps per vertex, or depth maps per
+// direction, in an OpenGL 4.3 context (raster_tracer.h; the views and the
+// bias are documented in shaders/raster_visibility.glsl and docs/baking.md).
+#include "visibility/raster/raster_tracer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <fmt/format.h>
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/mat4x4.hpp>
+#include <glm/vec4.hpp>
+
+#include "core/parallel.h"
+#include "gl/gl.h"
+#include "skybake/error.h"
+#include "skybake/interrupt.h"
+#include "skybake/mesh.h"
+#include "visibility/raster/shaders.h"
+#include "visibility/trace_hd.h"
+
+namespace skybake::visibility {
+
+namespace {
+
+// GPU (or llvmpipe) memory for the depth layers of one draw.
+constexpr std::uint64_t kDepthBytes = std::uint64_t(256) << 20;
+// GPU memory for one chunk's bits and vertex records.
+constexpr std::uint64_t kChunkBytes = std::uint64_t(256) << 20;
+// The near plane of the cube faces, as a fraction of the far plane. The ray
+// origin is already past the vertex's own surfaces (the driver's step and
+// offset), so the near plane only has to keep the projection finite.
+constexpr float kNearFraction = 1e-6f;
+constexpr int kFaces = 5;
+
+// The std430 layout of `Vertex` in raster_visibility.glsl.
+struct GpuVertex {
+    glm::vec4 origin, t, b, n, r0, r1, r2;
+};
+static_assert(sizeof(GpuVertex) == 112);
+
+// An orthonormal frame (t, b, n) around a unit n (Duff et al., JCGT 2017).
+void frame_of(const glm::vec3& n, glm::vec3& t, glm::vec3& b) {
+    const float s = std::copysign(1.0f, n.z);
+    const float a = -1.0f / (s + n.z);
+    const float c = n.x * n.y * a;
+    t = glm::vec3(1.0f + s * n.x * n.x * a, s * c, -s * n.x);
+    b = glm::vec3(c, s + n.y * n.y * a, -n.y);
+}
+
+gl::Buffer storage_buffer(std::size_t bytes) {
+    gl::Buffer b = gl::make_buffer();
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, b.get());
+    glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(std::max<std::size_t>(bytes, 16)), nullptr, GL_DYNAMIC_DRAW);
+    return b;
+}
+
+template <class T>
+void upload(const gl::Buffer& b, const std::vector<T>& data) {
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, b.get());
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(data.size() * sizeof(T)), data.data());
+}
+
+GLint uniform(GLuint program, const char* name) {
+    return glGetUniformLocation(program, name);
+}
+
+// At least `invocations` invocations of the 64-wide compute shader, as a 2D
+// grid when one row would pass the 65,535 groups every GL 4.3 has.
+void dispatch(std::uint64_t invocations) {
+    const std::uint64_t groups = (invocations + 63) / 64;
+    if (groups == 0)
+        return;
+    const std::uint64_t x = std::min<std::uint64_t>(groups, 65535);
+    glDispatchCompute(GLuint(x), GLuint((groups + x - 1) / x), 1);
+}
+
+} // namespace
+
+struct RasterTracer::State {
+    std::unique_ptr<gl::GlContext> context; // first: destroyed last
+    BackFaces back_faces = BackFaces::Occlude;
+    bool have_programs = false;
+    gl::Program draw, bits;
+    gl::VertexArray vao;
+    gl::Buffer positions, indices;
+    GLsizei index_count = 0;
+    std::vector<glm::vec3> vertex_positions; // the directional method's offset directions
+    glm::vec3 centre{0.0f};
+    float radius = 0.0f;
+    bool have_mesh = false;
+
+    TraceRule rule;
+    std::vector<glm::vec4> points;
+    std::uint32_t batch = 0;  // cube: vertices per draw; directional: directions per draw
+    std::uint32_t layers = 0; // of the depth array
+    gl::Buffer views, eyes, point_buffer, vertex_buffer, word_buffer;
+    std::size_t vertex_capacity = 0, word_capacity = 0;
+    gl::Texture depth;
+    gl::Framebuffer fbo;
+    GLint max_layers = 0, max_size = 0;
+};
+
+RasterTracer::RasterTracer(TraceMethod method, std::uint32_t resolution)
+    : method_(method), resolution_(resolution), s_(std::make_unique<State>()) {
+    if (method != TraceMethod::Cube && method != TraceMethod::Directional)
+        throw Error(
+            fmt::format("the raster backend has the methods cube and directional, not {}", trace_method_name(method)),
+            "method");
+    if (resolution_ == 0)
+        resolution_ = method == TraceMethod::Cube ? kRasterCubeResolution : kRasterDirectionalResolution;
+    if (resolution_ < 8 || resolution_ > kRasterMaxResolution)
+        throw Error(fmt::format("resolution must be 8 to {} texels; got {}", kRasterMaxResolution, resolution_),
+                    "resolution");
+    try {
+        s_->context = gl::create_headless_context();
+    } catch (const Error& e) {
+        throw Error("the raster backend needs OpenGL: " + e.message(), "backend");
+    }
+    if (!s_->context->at_least(4, 3))
+        throw Error(fmt::format("the raster backend needs OpenGL 4.3 (compute shaders, storage buffers); the context "
+                                "is {}",
+                                s_->context->description()),
+                    "backend");
+    glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &s_->max_layers);
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &s_->max_size);
+    if (GLint(resolution_) > s_->max_size)
+        throw Error(
+            fmt::format("resolution {} is more than this OpenGL's texture limit, {}", resolution_, s_->max_size),
+            "resolution");
+    if (method_ == TraceMethod::Cube && s_->max_layers < kFaces)
+        throw Error("this OpenGL has too few texture array layers for a hemicube", "backend");
+    s_->vao = gl::make_vertex_array();
+    s_->views = storage_buffer(0);
+    s_->eyes = storage_buffer(0);
+    s_->point_buffer = storage_buffer(0);
+    s_->vertex_buffer = storage_buffer(0);
+    s_->word_buffer = storage_buffer(0);
+    gl::check_gl("raster backend setup");
+}
+
+RasterTracer::~RasterTracer() {
+    if (s_ && s_->context) {
+        s_->context->make_current(); // the GL names are deleted with their context current
+        State* s = s_.get();
+        s->draw.reset();
+        s->bits.reset();
+        s->vao.reset();
+        s->positions.reset();
+        s->indices.reset();
+        s->views.reset();
+        s->eyes.reset();
+        s->point_buffer.reset();
+        s->vertex_buffer.reset();
+        s->word_buffer.reset();
+        s->depth.reset();
+        s->fbo.reset();
+    }
+}
+
+std::string RasterTracer::device_name() const {
+    s_->context->make_current();
+    const char* r = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    return r ? r : "OpenGL";
+}
+
+void RasterTracer::build_programs() {
+    const std::string head =
+        std::string("#version 430 core\n") +
+        (method_ == TraceMethod::Cube ? "#define SKYBAKE_CUBE\n" : "#define SKYBAKE_DIRECTIONAL\n") +
+        (s_->back_faces == BackFaces::Ignore ? "#define SKYBAKE_IGNORE_BACK_FACES\n" : "");
+    auto stage = [&](const char* define) {
+        return gl::ShaderSource{{head, std::string("#define ") + define + "\n", raster::shaders::raster_visibility}};
+    };
+    s_->draw = gl::link_program("raster visibility", {{GL_VERTEX_SHADER, stage("SKYBAKE_STAGE_VS")},
+                                                      {GL_GEOMETRY_SHADER, stage("SKYBAKE_STAGE_GS")},
+                                                      {GL_FRAGMENT_SHADER, stage("SKYBAKE_STAGE_FS")}});
+    s_->bits = gl::link_program("raster bits", {{GL_COMPUTE_SHADER, stage("SKYBAKE_STAGE_CS")}});
+    s_->have_programs = true;
+}
+
+void RasterTracer::set_mesh(const Mesh& mesh, BackFaces back_faces) {
+    validate_mesh(mesh, "mesh");
+    s_->context->make_current();
+    if (!s_->have_programs || back_faces != s_->back_faces) {
+        s_->back_faces = back_faces;
+        build_programs();
+    }
+    if (mesh.triangle_count() > std::size_t(std::numeric_limits<GLsizei>::max() / 3))
+        throw Error(fmt::format("{} triangles is too many for one OpenGL draw", mesh.triangle_count()), "mesh");
+    glBindVertexArray(s_->vao.get());
+    s_->positions = gl::make_buffer();
+    glBindBuffer(GL_ARRAY_BUFFER, s_->positions.get());
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(mesh.positions.size() * sizeof(glm::vec3)), mesh.positions.data(),
+                 GL_STATIC_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(glm::vec3), nullptr);
+    s_->indices = gl::make_buffer();
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, s_->indices.get());
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(mesh.indices.size() * sizeof(std::uint32_t)), mesh.indices.data(),
+                 GL_STATIC_DRAW);
+    s_->index_count = GLsizei(mesh.indices.size());
+    s_->vertex_positions = mesh.positions;
+    glBindVertexArray(0);
+    const Bounds bounds = compute_bounds(mesh);
+    s_->centre = 0.5f * (bounds.min + bounds.max);
+    s_->radius = std::max(0.5f * glm::length(bounds.extent()), 1e-30f);
+    s_->have_mesh = true;
+    gl::check_gl("raster backend mesh upload");
+}
+
+std::uint32_t RasterTracer::set_rule(const TraceRule& rule) {
+    if (!s_->have_mesh)
+        throw Error("set_mesh() must come before set_rule()", "mesh");
+    const auto k = std::uint32_t(rule.points.size());
+    if (method_ == TraceMethod::Directional) {
+        if (rule.rotate)
+            throw Error("the directional method draws one depth map per rule direction, so every vertex must share "
+                        "them: use a rule without +rotate, or the cube method",
+                        "rule");
+        if (std::isfinite(rule.t_max))
+            throw Error("the directional method sees the whole mesh along each direction, so it has no maximum "
+                        "distance: leave it unlimited, or use the cube method",
+                        "max_distance");
+    }
+    s_->context->make_current();
+    s_->rule = rule;
+    s_->points.resize(k);
+    for (std::uint32_t j = 0; j < k; ++j)
+        s_->points[j] = glm::vec4(rule.points[j], 0.0f);
+    s_->point_buffer = storage_buffer(s_->points.size() * sizeof(glm::vec4));
+    upload(s_->point_buffer, s_->points);
+
+    const std::uint64_t layer_bytes = std::uint64_t(resolution_) * resolution_ * 4;
+    std::uint32_t layers;
+    if (method_ == TraceMethod::Cube) {
+        s_->batch = std::uint32_t(
+            std::clamp<std::uint64_t>(kDepthBytes / (kFaces * layer_bytes), 1, std::uint64_t(s_->max_layers / kFaces)));
+        layers = s_->batch * kFaces;
+    } else {
+        s_->batch = std::uint32_t(
+            std::clamp<std::uint64_t>(kDepthBytes / layer_bytes, 1, std::min<std::uint64_t>(s_->max_layers, k)));
+        s_->batch = std::max<std::uint32_t>(s_->batch, 1);
+        layers = s_->batch;
+    }
+    if (layers != s_->layers || !s_->depth) {
+        s_->layers = layers;
+        s_->depth = gl::make_texture();
+        glBindTexture(GL_TEXTURE_2D_ARRAY, s_->depth.get());
+        glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_DEPTH_COMPONENT32F, GLsizei(resolution_), GLsizei(resolution_),
+                       GLsizei(layers));
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_COMPARE_MODE, GL_NONE);
+        GLuint id = 0;
+        glGenFramebuffers(1, &id);
+        s_->fbo = gl::Framebuffer(id);
+        glBindFramebuffer(GL_FRAMEBUFFER, id);
+        glFramebufferTexture(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, s_->depth.get(), 0); // layered
+        glDrawBuffer(GL_NONE);
+        glReadBuffer(GL_NONE);
+        const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        if (status != GL_FRAMEBUFFER_COMPLETE)
+            throw Error(fmt::format("a {0}x{0}x{1} depth texture array is not a complete framebuffer (status 0x{2:x})",
+                                    resolution_, layers, status),
+                        "backend");
+        s_->views = storage_buffer(layers * sizeof(glm::mat4));
+        s_->eyes = storage_buffer(layers * sizeof(glm::vec4));
+    }
+    gl::check_gl("raster backend rule setup");
+    const std::uint64_t per_vertex = 4ull * rule.words_per_vertex + sizeof(GpuVertex);
+    return std::uint32_t(std::clamp<std::uint64_t>(kChunkBytes / per_vertex, 1, 0xffffffffu));
+}
+
+namespace {
+
+// Binds the draw state shared by both methods: the depth array as the target,
+// depth test LESS, the mesh, the per-layer buffers.
+void begin_draw(GLuint fbo, std::uint32_t resolution, GLuint program, GLuint vao, GLuint views, GLuint eyes) {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glViewport(0, 0, GLsizei(resolution), GLsizei(resolution));
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    glClearDepth(1.0);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glUseProgram(program);
+    glBindVertexArray(vao);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, views);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, eyes);
+}
+
+} // namespace
+
+void RasterTracer::trace(const TraceChunk& chunk) {
+    if (!s_->have_mesh || s_->layers == 0)
+        throw Error("set_mesh() and set_rule() must come before trace()", "rule");
+    if (chunk.count == 0)
+        return;
+    s_->context->make_current();
+    const std::size_t words = std::size_t(chunk.count) * s_->rule.words_per_vertex;
+    if (words > s_->word_capacity) {
+        s_->word_buffer = storage_buffer(words * 4);
+        s_->word_capacity = words;
+    }
+    if (method_ == TraceMethod::Cube)
+        trace_cube(chunk);
+    else
+        trace_directional(chunk);
+
+    // The blocked bits, in visiting order, become V in rule order: set where
+    // the direction is on or above the horizon (the same test as every other
+    // backend) and nothing was drawn closer than the maximum distance.
+    std::vector<std::uint32_t> blocked(words);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, s_->word_buffer.get());
+    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(words * 4), blocked.data());
+    gl::check_gl("raster backend read-back");
+    const TraceRule& rule = s_->rule;
+    const auto k = std::uint32_t(rule.points.size());
+    parallel_for(chunk.count, 256, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+            const glm::mat3 r = rule.rotate ? chunk.rotations[i] : glm::mat3(1.0f);
+            const std::uint32_t* mine = blocked.data() + i * rule.words_per_vertex;
+            std::uint32_t* out = chunk.words.data() + i * rule.words_per_vertex;
+            std::fill(out, out + rule.words_per_vertex, 0u);
+            for (std::uint32_t j = 0; j < k; ++j) {
+                glm::vec3 x;
+                float c;
+                vertex_direction(rule.points[j], r, rule.rotate, chunk.normals[i], x, c);
+                if (needs_ray(c) && !get_bit(mine, j))
+                    set_bit(out, rule.order[j]);
+            }
+        }
+    });
+}
+
+void RasterTracer::trace_cube(const TraceChunk& chunk) {
+    State& s = *s_;
+    const TraceRule& rule = s.rule;
+    const std::uint32_t wpv = rule.words_per_vertex;
+    if (s.batch > s.vertex_capacity) {
+        s.vertex_buffer = storage_buffer(s.batch * sizeof(GpuVertex));
+        s.vertex_capacity = s.batch;
+    }
+    std::vector<glm::mat4> views(std::size_t(s.batch) * kFaces);
+    std::vector<glm::vec4> eyes(views.size());
+    std::vector<GpuVertex> vertices(s.batch);
+    const GLint cs_count = uniform(s.bits.get(), "u_count"), cs_first = uniform(s.bits.get(), "u_first");
+    const GLint fs_far = uniform(s.draw.get(), "u_far"), cs_far = uniform(s.bits.get(), "u_far");
+    for (std::uint32_t first = 0; first < chunk.count; first += s.batch) {
+        check_interrupted();
+        const std::uint32_t count = std::min(s.batch, chunk.count - first);
+        // One far plane for the batch: past every point of the mesh from every
+        // origin in it (and no further than needed for a maximum distance).
+        float far = 0.0f;
+        for (std::uint32_t i = 0; i < count; ++i)
+            far = std::max(far, glm::length(chunk.origins[first + i] - s.centre) + s.radius);
+        far *= 1.001f;
+        if (std::isfinite(rule.t_max))
+            far = std::min(far, rule.t_max * 1.001f);
+        far = std::max(far, 1e-30f);
+        const float near = far * kNearFraction;
+        const glm::mat4 top = glm::frustum(-near, near, -near, near, near, far);
+        const glm::mat4 side = glm::frustum(-near, near, 0.0f, near, near, far); // the half above the horizon
+        for (std::uint32_t i = 0; i < count; ++i) {
+            const glm::vec3 o = chunk.origins[first + i], n = chunk.normals[first + i];
+            glm::vec3 t, b;
+            frame_of(n, t, b);
+            const glm::vec3 zero(0.0f);
+            glm::mat4* v = &views[std::size_t(i) * kFaces];
+            v[0] = top * glm::lookAt(zero, n, b);
+            v[1] = side * glm::lookAt(zero, t, n);
+            v[2] = side * glm::lookAt(zero, -t, n);
+            v[3] = side * glm::lookAt(zero, b, n);
+            v[4] = side * glm::lookAt(zero, -b, n);
+            for (int f = 0; f < kFaces; ++f)
+                eyes[std::size_t(i) * kFaces + f] = glm::vec4(o, 1.0f);
+            GpuVertex& g = vertices[i];
+            g.origin = glm::vec4(o, 1.0f);
+            g.t = glm::vec4(t, 0.0f);
+            g.b = glm::vec4(b, 0.0f);
+            g.n = glm::vec4(n, 0.0f);
+            const glm::mat3 r = rule.rotate ? chunk.rotations[first + i] : glm::mat3(1.0f);
+            g.r0 = glm::vec4(r[0], 0.0f);
+            g.r1 = glm::vec4(r[1], 0.0f);
+            g.r2 = glm::vec4(r[2], 0.0f);
+        }
+        upload(s.views, views);
+        upload(s.eyes, eyes);
+        upload(s.vertex_buffer, vertices);
+
+        begin_draw(s.fbo.get(), resolution_, s.draw.get(), s.vao.get(), s.views.get(), s.eyes.get());
+        glUniform1f(fs_far, far);
+        glDrawElementsInstanced(GL_TRIANGLES, s.index_count, GL_UNSIGNED_INT, nullptr, GLsizei(count * kFaces));
+
+        glUseProgram(s.bits.get());
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, s.depth.get());
+        glUniform1i(uniform(s.bits.get(), "u_depth"), 0);
+        glUniform1i(cs_count, GLint(count));
+        glUniform1i(cs_first, GLint(first));
+        glUniform1i(uniform(s.bits.get(), "u_words_per_vertex"), GLint(wpv));
+        glUniform1i(uniform(s.bits.get(), "u_first_word"), 0);
+        glUniform1i(uniform(s.bits.get(), "u_word_count"), GLint(wpv));
+        glUniform1i(uniform(s.bits.get(), "u_first_point"), 0);
+        glUniform1i(uniform(s.bits.get(), "u_last_point"), GLint(rule.points.size()));
+        glUniform1i(uniform(s.bits.get(), "u_rotate"), rule.rotate ? 1 : 0);
+        glUniform1i(uniform(s.bits.get(), "u_resolution"), GLint(resolution_));
+        glUniform1f(cs_far, far);
+        glUniform1f(uniform(s.bits.get(), "u_t_max"), std::isfinite(rule.t_max) ? rule.t_max : 3.0e38f);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.views.get());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.point_buffer.get());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s.vertex_buffer.get());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s.word_buffer.get());
+        dispatch(std::uint64_t(count) * wpv);
+        gl::check_gl("raster backend cube pass");
+    }
+}
+
+void RasterTracer::trace_directional(const TraceChunk& chunk) {
+    State& s = *s_;
+    const TraceRule& rule = s.rule;
+    const std::uint32_t wpv = rule.words_per_vertex;
+    const auto k = std::uint32_t(rule.points.size());
+    if (chunk.count > s.vertex_capacity) {
+        s.vertex_buffer = storage_buffer(chunk.count * sizeof(GpuVertex));
+        s.vertex_capacity = chunk.count;
+    }
+    std::vector<GpuVertex> vertices(chunk.count);
+    for (std::uint32_t i = 0; i < chunk.count; ++i) {
+        GpuVertex& g = vertices[i];
+        g = GpuVertex{};
+        g.origin = glm::vec4(chunk.origins[i], 1.0f);
+        g.n = glm::vec4(chunk.normals[i], 0.0f);
+        // The direction the driver moved the origin off the vertex: the
+        // normal, or on borders and creases the normal plus a tangent.
+        const glm::vec3 off = chunk.origins[i] - s.vertex_positions[chunk.first + i];
+        const float len = glm::length(off);
+        g.t = glm::vec4(len > 0.0f ? off / len : chunk.normals[i], 0.0f);
+    }
+    upload(s.vertex_buffer, vertices);
+    // Every origin is inside the padded bounding sphere (origins sit a rounding
+    // step off the surface, plus the user's offset).
+    float r = s.radius;
+    for (std::uint32_t i = 0; i < chunk.count; ++i)
+        r = std::max(r, glm::length(chunk.origins[i] - s.centre));
+    r *= 1.01f;
+    const glm::mat4 ortho = glm::ortho(-r, r, -r, r, 0.25f * r, 2.75f * r);
+    const float range = 2.5f * r, texel = 2.0f * r / float(resolution_);
+    std::vector<glm::mat4> views(s.batch);
+    std::vector<glm::vec4> eyes(s.batch);
+    for (std::uint32_t j0 = 0; j0 < k; j0 += s.batch) {
+        check_interrupted();
+        const std::uint32_t j1 = std::min(k, j0 + s.batch);
+        for (std::uint32_t j = j0; j < j1; ++j) {
+            const glm::vec3 x = rule.points[j];
+            const glm::vec3 up = std::abs(x.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+            views[j - j0] = ortho * glm::lookAt(s.centre + 1.5f * r * x, s.centre, up);
+            eyes[j - j0] = glm::vec4(x, 0.0f);
+        }
+        upload(s.views, views);
+        upload(s.eyes, eyes);
+        begin_draw(s.fbo.get(), resolution_, s.draw.get(), s.vao.get(), s.views.get(), s.eyes.get());
+        glDrawElementsInstanced(GL_TRIANGLES, s.index_count, GL_UNSIGNED_INT, nullptr, GLsizei(j1 - j0));
+
+        const GLuint p = s.bits.get();
+        glUseProgram(p);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, s.depth.get());
+        glUniform1i(uniform(p, "u_depth"), 0);
+        const std::uint32_t w0 = j0 / 32, w1 = (j1 + 31) / 32;
+        glUniform1i(uniform(p, "u_count"), GLint(chunk.count));
+        glUniform1i(uniform(p, "u_first"), 0);
+        glUniform1i(uniform(p, "u_words_per_vertex"), GLint(wpv));
+        glUniform1i(uniform(p, "u_first_word"), GLint(w0));
+        glUniform1i(uniform(p, "u_word_count"), GLint(w1 - w0));
+        glUniform1i(uniform(p, "u_first_point"), GLint(j0));
+        glUniform1i(uniform(p, "u_last_point"), GLint(j1));
+        glUniform1i(uniform(p, "u_rotate"), 0);
+        glUniform1i(uniform(p, "u_resolution"), GLint(resolution_));
+        glUniform1f(uniform(p, "u_far"), range);
+        glUniform1f(uniform(p, "u_texel"), texel);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.views.get());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.point_buffer.get());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s.vertex_buffer.get());
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s.word_buffer.get());
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT); // the previous batch's words are read back in
+        dispatch(std::uint64_t(chunk.count) * (w1 - w0));
+        gl::check_gl("raster backend directional pass");
+    }
+}
+
+} // namespace skybake::visibility

@@ -1,0 +1,56 @@
+// Internal: the "raster" visibility backend, which answers with the depth
+// buffer of an OpenGL 4.3 context instead of rays (seed 002's third method,
+// like shadow mapping). Two methods (TraceMethod):
+//   Cube         at each vertex's ray origin, a depth hemicube of the mesh (the
+//                face along the normal and the upper halves of the four side
+//                faces); rule direction k reads its texel, and a surface closer
+//                than TraceRule::t_max there means blocked. Many vertices are
+//                drawn per call, as layers of a depth texture array.
+//   Directional  for each rule direction, one orthographic depth map of the
+//                whole mesh seen along it; every vertex is tested against it
+//                with a slope-scaled bias. Cost: directions × (triangles +
+//                vertices) instead of vertices × directions. Needs a rule
+//                without +rotate and an unlimited maximum distance.
+// The depth maps become bits in a compute pass; only the bits are read back.
+// The GL headers stay in the .cpp (the tracer owns its own headless context).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "skybake/visibility.h"
+
+namespace skybake::visibility {
+
+class RasterTracer final : public VisibilityTracer {
+public:
+    // Creates a headless OpenGL context; throws skybake::Error (where
+    // "backend") without one of version 4.3 or newer, and (where
+    // "resolution") for a resolution above kRasterMaxResolution or the
+    // context's texture limits. resolution 0 means the method's default.
+    RasterTracer(TraceMethod method, std::uint32_t resolution);
+    ~RasterTracer() override;
+
+    const char* name() const override { return "raster"; }
+    TraceMethod method() const override { return method_; }
+    std::string device_name() const override;
+    std::uint32_t resolution() const { return resolution_; }
+
+    void set_mesh(const Mesh& mesh, BackFaces back_faces = BackFaces::Occlude) override;
+    std::uint32_t set_rule(const TraceRule& rule) override;
+    void trace(const TraceChunk& chunk) override;
+    bool prefers_large_chunks() const override { return true; }
+
+private:
+    struct State;
+    void build_programs();
+    void trace_cube(const TraceChunk& chunk);
+    void trace_directional(const TraceChunk& chunk);
+
+    TraceMethod method_;
+    std::uint32_t resolution_;
+    std::unique_ptr<State> s_;
+};
+
+} // namespace skybake::visibility
