@@ -1,11 +1,10 @@
 // skybake ao --backend raster: the depth-buffer backend from the command line
 // (headless EGL; Mesa llvmpipe in CI), its JSON summary and its one-line
 // errors, with no output file.
-#include <gtest/gtest.h>
-
 #include <cstdlib>
 #include <filesystem>
 
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
@@ -89,6 +88,6 @@ TEST(RasterCli, FlagsThatDoNotFitAreUsageErrors) {
     expect_one_line_error(
         run_cli({"ao", in, "-o", out, "--backend", "raster", "--method", "directional", "--rule", "lebedev:50+rotate"}),
         2, "+rotate", out);
-    expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "raster", "--resolution", "4"}), 2,
-                          "--resolution", out);
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "raster", "--resolution", "4"}), 2, "--resolution",
+                          out);
 }

@@ -211,6 +211,29 @@ TEST(RasterBake, SameInputSameBits) {
     EXPECT_EQ(c.out.visibility_bits, d.out.visibility_bits);
 }
 
+// Where the vertex shader can choose the layer (Mesa, NVIDIA) no geometry
+// shader runs and face culling drops back faces; the geometry-shader path
+// (other drivers) must give the same bits, with either back-face policy.
+TEST(RasterBake, GeometryShaderPathGivesTheSameBits) {
+    const Mesh m = generated(ProceduralKind::City, 300);
+    const SphereRule rule = parse_rule("lebedev:110");
+    for (TraceMethod method : kMethods)
+        for (BackFaces faces : {BackFaces::Occlude, BackFaces::Ignore}) {
+            BakeOptions o;
+            o.back_faces = faces;
+            const Bake fast = bake(m, rule, "raster", method, 128, o);
+            setenv("SKYBAKE_RASTER_GEOMETRY_SHADER", "1", 1);
+            const Bake gs = bake(m, rule, "raster", method, 128, o);
+            unsetenv("SKYBAKE_RASTER_GEOMETRY_SHADER");
+            EXPECT_EQ(fast.out.visibility_bits, gs.out.visibility_bits)
+                << trace_method_name(method) << " " << back_faces_name(faces);
+            if (faces == BackFaces::Ignore) { // and ignoring back faces is seen
+                const Bake occlude = bake(m, rule, "raster", method, 128);
+                EXPECT_NE(fast.out.visibility_bits, occlude.out.visibility_bits) << trace_method_name(method);
+            }
+        }
+}
+
 TEST(RasterBake, OneTriangleSeesItsWholeHemisphere) {
     Mesh m;
     m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 0, -1}};

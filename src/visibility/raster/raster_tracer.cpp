@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <vector>
 
@@ -102,6 +103,10 @@ struct RasterTracer::State {
     gl::Texture depth;
     gl::Framebuffer fbo;
     GLint max_layers = 0, max_size = 0;
+    // The vertex shader writes gl_Layer (GL_ARB_shader_viewport_layer_array:
+    // Mesa, NVIDIA); else a geometry shader does. SKYBAKE_RASTER_GEOMETRY_SHADER=1
+    // forces the geometry shader (tests of that path).
+    bool vs_layer = false;
 };
 
 RasterTracer::RasterTracer(TraceMethod method, std::uint32_t resolution)
@@ -127,6 +132,8 @@ RasterTracer::RasterTracer(TraceMethod method, std::uint32_t resolution)
                     "backend");
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &s_->max_layers);
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &s_->max_size);
+    const char* force_gs = std::getenv("SKYBAKE_RASTER_GEOMETRY_SHADER");
+    s_->vs_layer = epoxy_has_gl_extension("GL_ARB_shader_viewport_layer_array") && !(force_gs && *force_gs == '1');
     if (GLint(resolution_) > s_->max_size)
         throw Error(
             fmt::format("resolution {} is more than this OpenGL's texture limit, {}", resolution_, s_->max_size),
@@ -173,11 +180,20 @@ void RasterTracer::build_programs() {
         (method_ == TraceMethod::Cube ? "#define SKYBAKE_CUBE\n" : "#define SKYBAKE_DIRECTIONAL\n") +
         (s_->back_faces == BackFaces::Ignore ? "#define SKYBAKE_IGNORE_BACK_FACES\n" : "");
     auto stage = [&](const char* define) {
-        return gl::ShaderSource{{head, std::string("#define ") + define + "\n", raster::shaders::raster_visibility}};
+        const bool vs_layer = s_->vs_layer && std::string(define) == "SKYBAKE_STAGE_VS";
+        return gl::ShaderSource{{head,
+                                 vs_layer ? "#extension GL_ARB_shader_viewport_layer_array : require\n"
+                                            "#define SKYBAKE_VS_LAYER\n"
+                                          : "",
+                                 std::string("#define ") + define + "\n", raster::shaders::raster_visibility}};
     };
-    s_->draw = gl::link_program("raster visibility", {{GL_VERTEX_SHADER, stage("SKYBAKE_STAGE_VS")},
-                                                      {GL_GEOMETRY_SHADER, stage("SKYBAKE_STAGE_GS")},
-                                                      {GL_FRAGMENT_SHADER, stage("SKYBAKE_STAGE_FS")}});
+    if (s_->vs_layer)
+        s_->draw = gl::link_program("raster visibility", {{GL_VERTEX_SHADER, stage("SKYBAKE_STAGE_VS")},
+                                                          {GL_FRAGMENT_SHADER, stage("SKYBAKE_STAGE_FS")}});
+    else
+        s_->draw = gl::link_program("raster visibility", {{GL_VERTEX_SHADER, stage("SKYBAKE_STAGE_VS")},
+                                                          {GL_GEOMETRY_SHADER, stage("SKYBAKE_STAGE_GS")},
+                                                          {GL_FRAGMENT_SHADER, stage("SKYBAKE_STAGE_FS")}});
     s_->bits = gl::link_program("raster bits", {{GL_COMPUTE_SHADER, stage("SKYBAKE_STAGE_CS")}});
     s_->have_programs = true;
 }
@@ -279,14 +295,22 @@ std::uint32_t RasterTracer::set_rule(const TraceRule& rule) {
 namespace {
 
 // Binds the draw state shared by both methods: the depth array as the target,
-// depth test LESS, the mesh, the per-layer buffers.
-void begin_draw(GLuint fbo, std::uint32_t resolution, GLuint program, GLuint vao, GLuint views, GLuint eyes) {
+// depth test LESS, the mesh, the per-layer buffers. `cull` is the face that
+// rays pass through (GL_FRONT, GL_BACK), or GL_NONE.
+void begin_draw(GLuint fbo, std::uint32_t resolution, GLuint program, GLuint vao, GLuint views, GLuint eyes,
+                GLenum cull) {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glViewport(0, 0, GLsizei(resolution), GLsizei(resolution));
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
-    glDisable(GL_CULL_FACE);
+    if (cull == GL_NONE) {
+        glDisable(GL_CULL_FACE);
+    } else {
+        glEnable(GL_CULL_FACE);
+        glFrontFace(GL_CCW);
+        glCullFace(cull);
+    }
     glDisable(GL_BLEND);
     glClearDepth(1.0);
     glClear(GL_DEPTH_BUFFER_BIT);
@@ -396,7 +420,10 @@ void RasterTracer::trace_cube(const TraceChunk& chunk) {
         upload(s.eyes, eyes);
         upload(s.vertex_buffer, vertices);
 
-        begin_draw(s.fbo.get(), resolution_, s.draw.get(), s.vao.get(), s.views.get(), s.eyes.get());
+        // Rays from the origin meet a triangle from behind where the camera at
+        // the origin sees its back: GL's back faces (the views do not mirror).
+        begin_draw(s.fbo.get(), resolution_, s.draw.get(), s.vao.get(), s.views.get(), s.eyes.get(),
+                   s.vs_layer && s.back_faces == BackFaces::Ignore ? GL_BACK : GL_NONE);
         glUniform1f(fs_far, far);
         glDrawElementsInstanced(GL_TRIANGLES, s.index_count, GL_UNSIGNED_INT, nullptr, GLsizei(count * kFaces));
 
@@ -467,7 +494,10 @@ void RasterTracer::trace_directional(const TraceChunk& chunk) {
         }
         upload(s.views, views);
         upload(s.eyes, eyes);
-        begin_draw(s.fbo.get(), resolution_, s.draw.get(), s.vao.get(), s.views.get(), s.eyes.get());
+        // Rays along x travel towards the camera: they meet from behind the
+        // triangles whose front the camera sees, GL's front faces.
+        begin_draw(s.fbo.get(), resolution_, s.draw.get(), s.vao.get(), s.views.get(), s.eyes.get(),
+                   s.vs_layer && s.back_faces == BackFaces::Ignore ? GL_FRONT : GL_NONE);
         glDrawElementsInstanced(GL_TRIANGLES, s.index_count, GL_UNSIGNED_INT, nullptr, GLsizei(j1 - j0));
 
         const GLuint p = s.bits.get();

@@ -2,8 +2,9 @@
 // depth maps drawn into the layers of a depth texture array, then turned into
 // "blocked" bits by a compute pass. The C++ side prepends #version 430 core
 // and defines one stage (SKYBAKE_STAGE_VS, _GS, _FS, _CS), one method
-// (SKYBAKE_CUBE or SKYBAKE_DIRECTIONAL) and, for BackFaces::Ignore,
-// SKYBAKE_IGNORE_BACK_FACES.
+// (SKYBAKE_CUBE or SKYBAKE_DIRECTIONAL), for BackFaces::Ignore
+// SKYBAKE_IGNORE_BACK_FACES, and SKYBAKE_VS_LAYER where the vertex shader can
+// choose the layer (then there is no geometry shader).
 //
 // One layer is one view:
 //   cube         layer 5·v + f is face f of vertex v's hemicube, in the
@@ -21,11 +22,20 @@ layout(std430, binding = 0) readonly buffer Views { mat4 u_view[]; };
 layout(std430, binding = 1) readonly buffer Eyes { vec4 u_eye[]; };
 
 #if defined(SKYBAKE_STAGE_VS)
+#if defined(SKYBAKE_VS_LAYER)
+// The layer is chosen here (GL_ARB_shader_viewport_layer_array, enabled by the
+// C++ side) and there is no geometry stage: the clipper drops what is outside
+// a view and face culling drops back faces (SKYBAKE_IGNORE_BACK_FACES).
+#define v_rel g_rel
+#endif
 layout(location = 0) in vec3 a_position;
 out vec3 v_rel;
 flat out int v_layer;
 void main() {
     v_layer = gl_InstanceID;
+#if defined(SKYBAKE_VS_LAYER)
+    gl_Layer = gl_InstanceID;
+#endif
     const vec4 e = u_eye[gl_InstanceID];
 #if defined(SKYBAKE_CUBE)
     v_rel = a_position - e.xyz; // relative to the ray origin: no cancellation far from the world origin
