@@ -3,6 +3,7 @@
 // barycentrics. The AO is shown as a display value (PNG grey level 255·AO),
 // which reads better than AO as linear light.
 #include <algorithm>
+#include <functional>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -13,11 +14,11 @@
 
 namespace skybake {
 
-Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
-    validate_mesh(mesh, "mesh");
-    const VertexAttribute* ao = mesh.find_attribute("ao");
-    if (!ao || ao->components != 1)
-        throw Error("the mesh has no baked 'ao' attribute to preview; bake it first", "mesh");
+namespace {
+
+// The camera and the ray cast; shade(triangle's indices, u, v) colours a hit.
+Image render_preview(const Mesh& mesh, const AoPreviewOptions& o,
+                     const std::function<glm::vec3(const std::uint32_t*, float, float)>& shade) {
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
         throw Error(fmt::format("preview size {}x{} is out of range; use 1 to 16384 pixels per side", o.width, o.height),
                     "width, height");
@@ -81,9 +82,7 @@ Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
                         continue;
                     }
                     const std::uint32_t* tri = &mesh.indices[3 * std::size_t(h.triangle)];
-                    const float a = (1.0f - h.u - h.v) * ao->values[tri[0]] + h.u * ao->values[tri[1]] +
-                                    h.v * ao->values[tri[2]];
-                    sum += glm::vec3(srgb_to_linear(std::clamp(a, 0.0f, 1.0f)));
+                    sum += shade(tri, h.u, h.v);
                 }
                 sum /= float(s * s);
                 float* p = img.pixel(x, y);
@@ -93,6 +92,28 @@ Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
             }
     }
     return img;
+}
+
+} // namespace
+
+Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
+    validate_mesh(mesh, "mesh");
+    const VertexAttribute* ao = mesh.find_attribute("ao");
+    if (!ao || ao->components != 1)
+        throw Error("the mesh has no baked 'ao' attribute to preview; bake it first", "mesh");
+    return render_preview(mesh, o, [&](const std::uint32_t* tri, float u, float v) {
+        const float a = (1.0f - u - v) * ao->values[tri[0]] + u * ao->values[tri[1]] + v * ao->values[tri[2]];
+        return glm::vec3(srgb_to_linear(std::clamp(a, 0.0f, 1.0f)));
+    });
+}
+
+Image render_vertex_preview(const Mesh& mesh, std::span<const glm::vec3> linear_rgb, const AoPreviewOptions& o) {
+    validate_mesh(mesh, "mesh");
+    if (linear_rgb.size() != mesh.vertex_count())
+        throw Error(fmt::format("{} vertex colours for {} vertices", linear_rgb.size(), mesh.vertex_count()), "mesh");
+    return render_preview(mesh, o, [&](const std::uint32_t* tri, float u, float v) {
+        return (1.0f - u - v) * linear_rgb[tri[0]] + u * linear_rgb[tri[1]] + v * linear_rgb[tri[2]];
+    });
 }
 
 } // namespace skybake
