@@ -276,6 +276,19 @@ glm::vec3 dprt_glossy(const SphereRule& phong, const ShLight& light, const glm::
 // The exact Phong integral of an SH light by Funk–Hecke (the reference).
 glm::vec3 phong_glossy_exact(const ShLight& light, double exponent_a, const glm::vec3& normal, const glm::vec3& view);
 
+// An image of a relit model through the ray-cast preview of skybake/bake.h
+// (render_ao_preview()'s camera): each hit gets the per-vertex `diffuse`
+// radiance (mesh.vertex_count() entries, e.g. from relight()) interpolated,
+// plus, when phong_exponent > 0, the DPRT glossy term
+//     specular · A · Σ_k λ_k L(g_nv x_k)
+// per pixel, with the normal and the shading coefficient A interpolated
+// (A = 1 when the transfer has none), v towards the eye, and the Phong rule
+// phong:a=exponent,n=order/2+1 (exact for the light's degree). A miss shows
+// the SH light along the ray (clamped at 0). Linear radiance.
+Image render_prt_preview(const Mesh& mesh, const Transfer& transfer, std::span<const glm::vec3> diffuse,
+                         const ShLight& light, double phong_exponent, float specular,
+                         const AoPreviewOptions& options = {});
+
 // [SECTION] Shader export --------------------------------------------------------------------
 //
 // GLSL for engines (any GLSL ≥ 3.30 or ES 3.00, vertex or fragment shader):

@@ -3,22 +3,19 @@
 // barycentrics. The AO is shown as a display value (PNG grey level 255·AO),
 // which reads better than AO as linear light.
 #include <algorithm>
-#include <functional>
 #include <cmath>
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "bake/preview.h"
 #include "skybake/bake.h"
 #include "skybake/error.h"
 
 namespace skybake {
 
-namespace {
-
-// The camera and the ray cast; shade(triangle's indices, u, v) colours a hit.
-Image render_preview(const Mesh& mesh, const AoPreviewOptions& o,
-                     const std::function<glm::vec3(const std::uint32_t*, float, float)>& shade) {
+Image bake::render_preview(const Mesh& mesh, const AoPreviewOptions& o, const bake::PreviewShader& shade,
+                           const bake::PreviewBackground& sky) {
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
         throw Error(fmt::format("preview size {}x{} is out of range; use 1 to 16384 pixels per side", o.width, o.height),
                     "width, height");
@@ -78,11 +75,11 @@ Image render_preview(const Mesh& mesh, const AoPreviewOptions& o,
                 for (std::size_t i = first; i < first + std::size_t(s * s); ++i) {
                     const RayHit& h = hits[i];
                     if (h.triangle == kNoHit) {
-                        sum += background;
+                        sum += sky ? sky(rays[i].direction) : background;
                         continue;
                     }
                     const std::uint32_t* tri = &mesh.indices[3 * std::size_t(h.triangle)];
-                    sum += shade(tri, h.u, h.v);
+                    sum += shade(tri, h.u, h.v, rays[i].direction);
                 }
                 sum /= float(s * s);
                 float* p = img.pixel(x, y);
@@ -94,14 +91,12 @@ Image render_preview(const Mesh& mesh, const AoPreviewOptions& o,
     return img;
 }
 
-} // namespace
-
 Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
     validate_mesh(mesh, "mesh");
     const VertexAttribute* ao = mesh.find_attribute("ao");
     if (!ao || ao->components != 1)
         throw Error("the mesh has no baked 'ao' attribute to preview; bake it first", "mesh");
-    return render_preview(mesh, o, [&](const std::uint32_t* tri, float u, float v) {
+    return bake::render_preview(mesh, o, [&](const std::uint32_t* tri, float u, float v, const glm::vec3&) {
         const float a = (1.0f - u - v) * ao->values[tri[0]] + u * ao->values[tri[1]] + v * ao->values[tri[2]];
         return glm::vec3(srgb_to_linear(std::clamp(a, 0.0f, 1.0f)));
     });
@@ -111,7 +106,7 @@ Image render_vertex_preview(const Mesh& mesh, std::span<const glm::vec3> linear_
     validate_mesh(mesh, "mesh");
     if (linear_rgb.size() != mesh.vertex_count())
         throw Error(fmt::format("{} vertex colours for {} vertices", linear_rgb.size(), mesh.vertex_count()), "mesh");
-    return render_preview(mesh, o, [&](const std::uint32_t* tri, float u, float v) {
+    return bake::render_preview(mesh, o, [&](const std::uint32_t* tri, float u, float v, const glm::vec3&) {
         return (1.0f - u - v) * linear_rgb[tri[0]] + u * linear_rgb[tri[1]] + v * linear_rgb[tri[2]];
     });
 }

@@ -6,6 +6,7 @@
 #include <glm/geometric.hpp>
 
 #include "bake/driver.h"
+#include "bake/preview.h"
 #include "core/parallel.h"
 #include "skybake/error.h"
 #include "skybake/prt.h"
@@ -67,6 +68,47 @@ std::vector<float> sun_visibility(const Mesh& mesh, const glm::vec3& sun_directi
     for (std::size_t v = 0; v < n; ++v)
         out[v] = occ[v] || glm::dot(vr.normals[v], sun_direction) < 0.0f ? 0.0f : 1.0f;
     return out;
+}
+
+Image render_prt_preview(const Mesh& mesh, const Transfer& transfer, std::span<const glm::vec3> diffuse,
+                         const ShLight& light, double phong_exponent, float specular, const AoPreviewOptions& options) {
+    validate_mesh(mesh, "mesh");
+    const std::size_t n = mesh.vertex_count();
+    if (diffuse.size() != n)
+        throw Error(fmt::format("{} radiance values for {} vertices", diffuse.size(), n), "mesh");
+    if (!(phong_exponent >= 0.0) || !std::isfinite(phong_exponent))
+        throw Error(fmt::format("the Phong exponent must be ≥ 0; got {}", phong_exponent), "exponent");
+    const bool glossy = phong_exponent > 0.0 && specular > 0.0f;
+    std::vector<glm::vec3> normals = bake::bake_normals(mesh);
+    const SphereRule rule = glossy ? phong_rule(phong_exponent, light.order / 2 + 1) : SphereRule{};
+    const std::vector<glm::dvec3> c(light.coeffs.begin(), light.coeffs.end());
+    const bool have_a = transfer.shading.size() == n;
+    return bake::render_preview(
+        mesh, options,
+        [&](const std::uint32_t* t, float u, float v, const glm::vec3& dir) {
+            const float w0 = 1.0f - u - v;
+            glm::vec3 rgb = w0 * diffuse[t[0]] + u * diffuse[t[1]] + v * diffuse[t[2]];
+            if (!glossy)
+                return rgb;
+            glm::vec3 nrm = w0 * normals[t[0]] + u * normals[t[1]] + v * normals[t[2]];
+            const float len = glm::length(nrm);
+            if (!(len > 0.0f))
+                return rgb;
+            nrm /= len;
+            const glm::vec3 view = -dir;
+            if (glm::dot(nrm, view) < 0.0f)
+                nrm = -nrm; // seen from behind
+            const float a =
+                have_a ? w0 * transfer.shading[t[0]] + u * transfer.shading[t[1]] + v * transfer.shading[t[2]] : 1.0f;
+            const glm::vec3 g = dprt_glossy(
+                rule,
+                [&](const glm::vec3& x) {
+                    return glm::max(glm::vec3(sh_evaluate(c, light.order, glm::dvec3(x))), 0.0f);
+                },
+                nrm, view);
+            return rgb + specular * a * g;
+        },
+        [&](const glm::vec3& dir) { return glm::max(glm::vec3(sh_evaluate(c, light.order, glm::dvec3(dir))), 0.0f); });
 }
 
 } // namespace skybake
