@@ -147,7 +147,7 @@ struct TransferReport {
     std::string backend, rule;
     std::size_t vertices = 0, triangles = 0, directions = 0;
     std::uint64_t rays = 0;        // visibility rays
-    std::uint64_t bounce_rays = 0; // closest-hit rays of the bounces
+    std::uint64_t bounce_rays = 0; // closest-hit rays: one per occluded direction, reused by every bounce
     double seconds = 0.0, trace_seconds = 0.0, bounce_seconds = 0.0;
     float ray_offset = 0.0f;
 };

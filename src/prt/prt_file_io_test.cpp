@@ -1,5 +1,6 @@
 // Transfer files (skybake/prt.h, [SECTION] Files): attributes and sidecar
 // round trip through glTF and PLY, and the refusals of a bad sidecar.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -106,6 +107,30 @@ TEST(PrtFile, BadSidecars) {
     // A sidecar that matches another mesh: the attributes are missing.
     save_mesh(path, mesh);
     EXPECT_EQ(with(good), "sidecar");
+}
+
+TEST(PrtFile, RadianceHdrMapIsALight) {
+    TempDir dir;
+    // A 4x2 Radiance RGBE file (flat pixels, no run-length encoding below
+    // width 8): every pixel (128, 128, 128, 129) = 0.5 · 2^1 = 1.0.
+    const auto path = dir.path / "white.hdr";
+    {
+        std::ofstream f(path, std::ios::binary);
+        f << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 4\n";
+        for (int i = 0; i < 8; ++i)
+            f << char(128) << char(128) << char(128) << char(129);
+    }
+    const Image map = load_image(path);
+    ASSERT_EQ(map.width, 4);
+    ASSERT_EQ(map.height, 2);
+    EXPECT_FLOAT_EQ(map.rgb[5], 1.0f);
+    const ShLight l = equirect_light(map, 2, parse_rule("lebedev:50"));
+    EXPECT_NEAR(l.coeffs[0].y, 2.0 * std::sqrt(M_PI), 1e-5);
+    EXPECT_NEAR(l.coeffs[1].y, 0.0, 1e-5);
+    // Not an image at all.
+    const auto bad = dir.path / "bad.hdr";
+    std::ofstream(bad) << "#?RADIANCE\nnonsense";
+    EXPECT_THROW(load_image(bad), Error);
 }
 
 } // namespace

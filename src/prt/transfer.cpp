@@ -170,7 +170,7 @@ void add_bounces(const Mesh& mesh, const SphereRule& rule, const BakeOptions& ba
     }
     std::vector<RayHit> hits(rays.size());
     queries.intersect(rays, hits);
-    report.bounce_rays = rays.size() * std::uint64_t(bounces);
+    report.bounce_rays = rays.size(); // traced once, gathered by every bounce
     for (std::size_t g = 0; g < gathers.size(); ++g) {
         gathers[g].triangle = hits[g].triangle;
         gathers[g].u = hits[g].u;
