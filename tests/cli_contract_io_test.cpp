@@ -193,6 +193,10 @@ const NumericFlag kNumericFlags[] = {
     {{"sky", "sh", "-o", "{out}/l.json"}, "--sun-azimuth-deg", true, true},
     {{"sky", "sh", "-o", "{out}/l.json"}, "--altitude-km", false, true},
     {{"sky", "sh", "-o", "{out}/l.json"}, "--order", false, true},
+    {{"prt", "export", "-o", "{out}/p.glsl"}, "--order", false, true},
+    {{"prt", "export", "-o", "{out}/p.glsl"}, "--channels", false, false},
+    {{"prt", "export", "--model", "{model}", "-o", "{out}/p.glsl"}, "--glossy", false, false},
+    {{"prt", "export", "--model", "{model}", "--glossy", "8", "-o", "{out}/p.glsl"}, "--nodes", false, false},
 };
 
 } // namespace
@@ -259,6 +263,7 @@ const OutputFlag kOutputFlags[] = {
     {{"sphere", "export", "lebedev:6"}, "-o", "r.csv"},
     {{"prt", "bake", "{in}", "--rule", "lebedev:6"}, "-o", "p.glb"},
     {{"sky", "sh", "--rule", "lebedev:50"}, "-o", "l.json"},
+    {{"prt", "export", "--model", "{model}", "--glossy", "8"}, "-o", "p.glsl"},
 };
 
 } // namespace

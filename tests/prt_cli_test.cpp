@@ -79,6 +79,15 @@ TEST(PrtCli, BakeRelightPlyAndPng) {
     EXPECT_GT(l.sun_irradiance.x, l.sun_irradiance.z); // a low sun is red
     r = run_cli({"prt", "relight", out, "--light", light, "-o", dir + "/lit2.ply"});
     EXPECT_EQ(r.exit_code, 0) << r.err;
+    // The GLSL, with the order of the sidecar.
+    r = run_cli({"prt", "export", out, "-o", dir + "/prt.glsl"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream g(dir + "/prt.glsl");
+    const std::string glsl((std::istreambuf_iterator<char>(g)), {});
+    EXPECT_NE(glsl.find("vec3 skybake_prt_diffuse(vec4 prt[3], vec3 light[9], vec3 albedo)"), std::string::npos);
+    r = run_cli({"prt", "export", out, "--order", "2", "-o", dir + "/x.glsl"});
+    expect_refused(r, 2, "--order");
+    EXPECT_FALSE(fs::exists(dir + "/x.glsl"));
 }
 
 TEST(PrtCli, BadInput) {
