@@ -86,7 +86,7 @@ void run(const BakeOpts& o, const CLI::App& sub) {
         constant_albedo ? std::vector<glm::vec3>(mesh.vertex_count(), albedo_value) : mesh_albedo(mesh, albedo_value);
     const std::string albedo_source =
         constant_albedo ? fmt::format("[{}, {}, {}]", albedo_value.x, albedo_value.y, albedo_value.z)
-                        : (mesh.colors.size() == mesh.vertex_count() ? "vertex-colors" : "default [0.8, 0.8, 0.8]");
+                        : (mesh.colors.size() == mesh.vertex_count() ? "vertex-colors" : "[0.8, 0.8, 0.8]");
     BakeOptions b;
     b.max_distance = float(o.max_distance);
     Transfer transfer;

@@ -327,7 +327,8 @@ std::string export_prt_glsl(int order, int channels, const PrtShaderOptions& opt
 std::filesystem::path prt_sidecar_path(const std::filesystem::path& mesh_path);
 // Stores the transfer and the albedo on the mesh as attributes.
 void set_transfer_attributes(Mesh& mesh, const Transfer& transfer, std::span<const glm::vec3> albedo);
-// The sidecar's JSON text. albedo_source: "vertex-colors" or the constant albedo.
+// The sidecar's JSON text. albedo_source: "vertex-colors", or the constant
+// albedo as a JSON array "[r, g, b]" (stored as an array).
 std::string transfer_sidecar_json(const Transfer& transfer, std::size_t vertices, const std::string& albedo_source);
 
 // Light file (`skybake sky sh`):

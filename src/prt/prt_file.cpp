@@ -67,7 +67,8 @@ std::string transfer_sidecar_json(const Transfer& t, std::size_t vertices, const
                         {"model", transfer_model_name(t.model)},
                         {"bounces", t.bounces},
                         {"rule", t.rule},
-                        {"albedo", albedo_source},
+                        {"albedo", albedo_source.starts_with('[') ? nlohmann::json::parse(albedo_source)
+                                                                  : nlohmann::json(albedo_source)},
                         {"vertices", vertices},
                         {"attributes", attrs}};
     return j.dump(2) + "\n";

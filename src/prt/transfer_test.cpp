@@ -192,6 +192,53 @@ TEST(Transfer, BouncesAddLessEachTime) {
     }
 }
 
+// Inside a sphere, the form factor from any point to a piece of the sphere
+// is that piece's area over 4πR². For the hemispherical bowl every inner point
+// therefore sees the open half (AO = f = 1/2) and gathers from the bowl with
+// weight 1 − f, whatever its place: under constant light L and albedo ρ,
+//     B_N = ρ L f Σ_{k=0..N} (ρ (1 − f))^k  →  ρ L f / (1 − ρ (1 − f)).
+TEST(Transfer, BowlConvergesToTheInfiniteBounceLimit) {
+    ProceduralOptions p;
+    p.kind = ProceduralKind::Bowl;
+    p.target_triangles = 4000;
+    Mesh mesh = generate_mesh(p);
+    compute_normals(mesh);
+    const SphereRule rule = parse_rule("lebedev:1202");
+    const auto tracer = make_visibility_tracer("embree");
+    const auto queries = make_ray_queries("embree");
+    const float rho = 0.6f;
+    const std::vector<glm::vec3> albedo(mesh.vertex_count(), glm::vec3(rho));
+    const double f = 0.5;
+    for (int n : {1, 3, 8}) {
+        TransferOptions o;
+        o.order = 0;
+        o.kind = TransferKind::Interreflected;
+        o.bounces = n;
+        Transfer t;
+        bake_transfer(mesh, rule, *tracer, BakeOptions{}, o, albedo, queries.get(), t);
+        const std::vector<glm::vec3> b = relight(t, constant_light(glm::vec3(1.0f), 0), albedo);
+        double want = 0.0;
+        for (int k = 0; k <= n; ++k)
+            want += rho * f * std::pow(rho * (1.0 - f), k);
+        double worst = 0.0, mean = 0.0;
+        std::size_t count = 0;
+        for (std::size_t v = 0; v < b.size(); ++v)
+            if (mesh.positions[v].y < -0.3f) { // away from the rim
+                worst = std::max(worst, std::abs(double(b[v].x) / want - 1.0));
+                mean += double(b[v].x);
+                ++count;
+            }
+        std::printf("bowl, %d bounces: closed form %.5f (limit %.5f), mean %.5f over %zu vertices, max relative "
+                    "error %.3g\n",
+                    n, want, rho * f / (1.0 - rho * (1.0 - f)), mean / double(count), count, worst);
+        EXPECT_GT(count, 100u);
+        // Each vertex has the rule's error for the visibility step at the
+        // rim's circle (a few percent with lebedev:1202); it averages out.
+        EXPECT_NEAR(mean / double(count) / want, 1.0, 1e-3) << n;
+        EXPECT_LT(worst, 0.05) << n;
+    }
+}
+
 TEST(Transfer, ConvexSphereHasNoBounces) {
     Mesh mesh = sphere_mesh(500);
     const SphereRule rule = parse_rule("lebedev:302");
