@@ -180,6 +180,23 @@ const NumericFlag kNumericFlags[] = {
     {{"sky", "preset", "paper"}, "--paper-m", false, false},
     {{"sphere", "show", "lebedev:6"}, "--limit", false, true},
     {{"sphere", "list"}, "--threads", false, true},
+    {{"prt", "bake", "{in}", "-o", "{out}/p.glb"}, "--order", false, true},
+    {{"prt", "bake", "{in}", "-o", "{out}/p.glb"}, "--bounces", false, true},
+    {{"prt", "bake", "{in}", "-o", "{out}/p.glb"}, "--max-distance", false, false},
+    {{"prt", "relight", "{in}", "-o", "{out}/r.png"}, "--sun-elevation-deg", true, true},
+    {{"prt", "relight", "{in}", "-o", "{out}/r.png"}, "--sun-azimuth-deg", true, true},
+    {{"prt", "relight", "{in}", "-o", "{out}/r.png"}, "--altitude-km", false, true},
+    {{"prt", "relight", "{in}", "--light", "constant", "-o", "{out}/r.png"}, "--radiance", false, true},
+    {{"prt", "relight", "{in}", "-o", "{out}/r.png"}, "--glossy", false, true},
+    {{"prt", "relight", "{in}", "-o", "{out}/r.png"}, "--specular", false, true},
+    {{"sky", "sh", "-o", "{out}/l.json"}, "--sun-elevation-deg", true, true},
+    {{"sky", "sh", "-o", "{out}/l.json"}, "--sun-azimuth-deg", true, true},
+    {{"sky", "sh", "-o", "{out}/l.json"}, "--altitude-km", false, true},
+    {{"sky", "sh", "-o", "{out}/l.json"}, "--order", false, true},
+    {{"prt", "export", "-o", "{out}/p.glsl"}, "--order", false, true},
+    {{"prt", "export", "-o", "{out}/p.glsl"}, "--channels", false, false},
+    {{"prt", "export", "--model", "{model}", "-o", "{out}/p.glsl"}, "--glossy", false, false},
+    {{"prt", "export", "--model", "{model}", "--glossy", "8", "-o", "{out}/p.glsl"}, "--nodes", false, false},
 };
 
 } // namespace
@@ -244,6 +261,9 @@ const OutputFlag kOutputFlags[] = {
     {{"sky", "preset", "earth"}, "-o", "e.json"},
     {{"sky", "error", "--model", "{model}", "--samples", "100", "--size", "8x8"}, "--views-dir", "views"},
     {{"sphere", "export", "lebedev:6"}, "-o", "r.csv"},
+    {{"prt", "bake", "{in}", "--rule", "lebedev:6"}, "-o", "p.glb"},
+    {{"sky", "sh", "--rule", "lebedev:50"}, "-o", "l.json"},
+    {{"prt", "export", "--model", "{model}", "--glossy", "8"}, "-o", "p.glsl"},
 };
 
 } // namespace

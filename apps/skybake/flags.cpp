@@ -184,6 +184,11 @@ std::string flag_for_field(const std::string& where) {
         {"name", "--name"},
         {"kind", "--kind"},
         {"target_triangles", "--triangles"},
+        {"order", "--order"},
+        {"bounces", "--bounces"},
+        {"model", "--model"},
+        {"albedo", "--albedo"},
+        {"light", "--light"},
     };
     for (const auto& [field, flag] : kFields)
         if (where == field)

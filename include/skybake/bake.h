@@ -291,5 +291,9 @@ struct AoPreviewOptions {
 // 255·AO. Background: a dark blue-grey. 2×2 samples per pixel by default. The
 // mesh must carry the "ao" attribute.
 Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& options = {});
+// The same camera, shading each visible point by a per-vertex linear RGB value
+// (linear_rgb: mesh.vertex_count() entries) interpolated across the triangle.
+Image render_vertex_preview(const Mesh& mesh, std::span<const glm::vec3> linear_rgb,
+                            const AoPreviewOptions& options = {});
 
 } // namespace skybake

@@ -69,7 +69,7 @@ void save_png(const std::filesystem::path& path, const Image& image, const ToneM
 // Writes an 8-bit sRGB buffer (3 bytes per pixel) as PNG.
 void save_png_srgb8(const std::filesystem::path& path, int width, int height, const std::uint8_t* rgb);
 
-// Reads an EXR (linear) or a PNG/JPEG (sRGB, decoded to linear).
+// Reads an EXR or a Radiance .hdr (linear) or a PNG/JPEG (sRGB, decoded to linear).
 // Throws skybake::Error on a missing or corrupt file.
 Image load_image(const std::filesystem::path& path);
 

@@ -8,16 +8,14 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "bake/preview.h"
 #include "skybake/bake.h"
 #include "skybake/error.h"
 
 namespace skybake {
 
-Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
-    validate_mesh(mesh, "mesh");
-    const VertexAttribute* ao = mesh.find_attribute("ao");
-    if (!ao || ao->components != 1)
-        throw Error("the mesh has no baked 'ao' attribute to preview; bake it first", "mesh");
+Image bake::render_preview(const Mesh& mesh, const AoPreviewOptions& o, const bake::PreviewShader& shade,
+                           const bake::PreviewBackground& sky) {
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
         throw Error(fmt::format("preview size {}x{} is out of range; use 1 to 16384 pixels per side", o.width, o.height),
                     "width, height");
@@ -77,13 +75,11 @@ Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
                 for (std::size_t i = first; i < first + std::size_t(s * s); ++i) {
                     const RayHit& h = hits[i];
                     if (h.triangle == kNoHit) {
-                        sum += background;
+                        sum += sky ? sky(rays[i].direction) : background;
                         continue;
                     }
                     const std::uint32_t* tri = &mesh.indices[3 * std::size_t(h.triangle)];
-                    const float a = (1.0f - h.u - h.v) * ao->values[tri[0]] + h.u * ao->values[tri[1]] +
-                                    h.v * ao->values[tri[2]];
-                    sum += glm::vec3(srgb_to_linear(std::clamp(a, 0.0f, 1.0f)));
+                    sum += shade(tri, h.u, h.v, rays[i].direction);
                 }
                 sum /= float(s * s);
                 float* p = img.pixel(x, y);
@@ -93,6 +89,26 @@ Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
             }
     }
     return img;
+}
+
+Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
+    validate_mesh(mesh, "mesh");
+    const VertexAttribute* ao = mesh.find_attribute("ao");
+    if (!ao || ao->components != 1)
+        throw Error("the mesh has no baked 'ao' attribute to preview; bake it first", "mesh");
+    return bake::render_preview(mesh, o, [&](const std::uint32_t* tri, float u, float v, const glm::vec3&) {
+        const float a = (1.0f - u - v) * ao->values[tri[0]] + u * ao->values[tri[1]] + v * ao->values[tri[2]];
+        return glm::vec3(srgb_to_linear(std::clamp(a, 0.0f, 1.0f)));
+    });
+}
+
+Image render_vertex_preview(const Mesh& mesh, std::span<const glm::vec3> linear_rgb, const AoPreviewOptions& o) {
+    validate_mesh(mesh, "mesh");
+    if (linear_rgb.size() != mesh.vertex_count())
+        throw Error(fmt::format("{} vertex colours for {} vertices", linear_rgb.size(), mesh.vertex_count()), "mesh");
+    return bake::render_preview(mesh, o, [&](const std::uint32_t* tri, float u, float v, const glm::vec3&) {
+        return (1.0f - u - v) * linear_rgb[tri[0]] + u * linear_rgb[tri[1]] + v * linear_rgb[tri[2]];
+    });
 }
 
 } // namespace skybake

@@ -21,6 +21,7 @@
 #define STB_IMAGE_STATIC
 #define STBI_ONLY_PNG
 #define STBI_ONLY_JPEG
+#define STBI_ONLY_HDR
 #include <stb_image.h>
 
 namespace skybake {
@@ -190,6 +191,16 @@ Image load_image(const fs::path& path) {
     }
     const std::string data = read_file(path, std::uint64_t(1) << 30);
     int w = 0, h = 0, comp = 0;
+    if (ext == ".hdr") { // Radiance RGBE: linear radiance
+        float* f = stbi_loadf_from_memory(reinterpret_cast<const stbi_uc*>(data.data()), int(data.size()), &w, &h,
+                                          &comp, 3);
+        if (!f)
+            throw Error(fmt::format("cannot decode Radiance HDR image: {}", stbi_failure_reason()), path.string());
+        std::unique_ptr<float, void (*)(void*)> guard(f, stbi_image_free);
+        Image img(w, h);
+        std::copy(f, f + img.rgb.size(), img.rgb.begin());
+        return img;
+    }
     unsigned char* px = stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(data.data()), int(data.size()), &w,
                                               &h, &comp, 3);
     if (!px)

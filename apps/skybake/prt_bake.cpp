@@ -1,0 +1,167 @@
+// skybake prt bake INPUT -o OUTPUT.glb|.ply [--order L] [--kind K] [--bounces N] [--rule R] [--backend B]
+//                  [--device D] [--albedo A] [--model prt|shading-coefficient] [--max-distance D] [--json]
+// Per-vertex diffuse SH transfer (skybake/prt.h), with a JSON sidecar.
+#include <limits>
+#include <sstream>
+
+#include "cli.h"
+#include "commands.h"
+#include "flags.h"
+#include "skybake/files.h"
+#include "skybake/mesh.h"
+#include "skybake/prt.h"
+
+namespace skybake::cli {
+
+namespace {
+
+struct BakeOpts {
+    std::string input, output, rule = "lebedev:590", kind = "shadowed", model = "prt", albedo, backend, device = "cpu";
+    int order = 3, bounces = 0;
+    double max_distance = std::numeric_limits<double>::infinity();
+    bool json = false;
+};
+
+// "0.8" or "0.8,0.6,0.4": a linear RGB reflectance in [0, 1].
+glm::vec3 parse_albedo(const std::string& text) {
+    std::vector<float> v;
+    std::stringstream s(text);
+    std::string part;
+    while (std::getline(s, part, ',')) {
+        std::size_t used = 0;
+        float x = 0.0f;
+        try {
+            x = std::stof(part, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used != part.size() || part.empty() || !(x >= 0.0f && x <= 1.0f))
+            throw UsageError(fmt::format("albedo '{}' is not a reflectance; give one or three numbers in [0, 1], "
+                                         "e.g. 0.8 or 0.8,0.6,0.4",
+                                         text),
+                             "--albedo");
+        v.push_back(x);
+    }
+    if (v.size() == 1)
+        return glm::vec3(v[0]);
+    if (v.size() == 3)
+        return {v[0], v[1], v[2]};
+    throw UsageError(fmt::format("albedo '{}' needs one or three numbers", text), "--albedo");
+}
+
+void run(const BakeOpts& o, const CLI::App& sub) {
+    const SphereRule rule = parse_flag("--rule", [&] { return parse_rule(o.rule); });
+    if (rule.kind == RuleKind::Phong)
+        throw UsageError(fmt::format("'{}' integrates against a Phong lobe, not over the sphere; use a lebedev, "
+                                     "design, fibonacci or mc rule for a transfer bake",
+                                     rule.spec),
+                         "--rule");
+    TransferOptions t;
+    t.order = o.order;
+    t.bounces = o.bounces;
+    t.kind = parse_flag("--kind", [&] { return parse_transfer_kind(o.kind); });
+    if (o.bounces > 0 && !given(sub, "--kind"))
+        t.kind = TransferKind::Interreflected;
+    if (t.kind == TransferKind::Interreflected && o.bounces == 0)
+        throw UsageError("interreflected transfer needs --bounces N (1 to 16)", "--bounces");
+    if (o.bounces > 0 && t.kind != TransferKind::Interreflected)
+        throw UsageError(fmt::format("--bounces needs --kind interreflected, not {}", o.kind), "--bounces");
+    t.model = parse_flag("--model", [&] { return parse_transfer_model(o.model); });
+    if (t.model == TransferModel::ShadingCoefficient && o.bounces > 0)
+        throw UsageError("the shading-coefficient model has no bounces", "--bounces");
+    const Device device = parse_flag("--device", [&] { return parse_device(o.device); });
+    std::string backend = o.backend.empty() ? (device == Device::Cuda ? "cuda" : "embree") : o.backend;
+    if (backend != "embree" && backend != "brute" && backend != "cuda")
+        throw UsageError(fmt::format("unknown backend '{}'; use embree, brute or cuda", backend), "--backend");
+    const bool constant_albedo = !o.albedo.empty();
+    const glm::vec3 albedo_value = constant_albedo ? parse_albedo(o.albedo) : glm::vec3(0.8f);
+    check_output_path(o.output, {".glb", ".ply"}, "--output");
+    const auto tracer = make_visibility_tracer(backend);
+    std::unique_ptr<RayQueries> queries;
+    if (t.kind == TransferKind::Interreflected)
+        queries = make_ray_queries(backend);
+
+    Mesh mesh = load_mesh(o.input);
+    const std::vector<glm::vec3> albedo =
+        constant_albedo ? std::vector<glm::vec3>(mesh.vertex_count(), albedo_value) : mesh_albedo(mesh, albedo_value);
+    const std::string albedo_source =
+        constant_albedo ? fmt::format("[{}, {}, {}]", albedo_value.x, albedo_value.y, albedo_value.z)
+                        : (mesh.colors.size() == mesh.vertex_count() ? "vertex-colors" : "[0.8, 0.8, 0.8]");
+    BakeOptions b;
+    b.max_distance = float(o.max_distance);
+    Transfer transfer;
+    const TransferReport r = bake_transfer(mesh, rule, *tracer, b, t, albedo, queries.get(), transfer);
+    set_transfer_attributes(mesh, transfer, albedo);
+
+    OutputSet files;
+    save_mesh(files.stage(o.output), mesh);
+    const std::string side = transfer_sidecar_json(transfer, mesh.vertex_count(), albedo_source);
+    write_stream_atomic(files.stage(prt_sidecar_path(o.output)), [&](std::ostream& out) { out << side; });
+    files.commit();
+
+    if (o.json) {
+        print_json({{"input", o.input},
+                    {"output", o.output},
+                    {"sidecar", prt_sidecar_path(o.output).string()},
+                    {"backend", r.backend},
+                    {"rule", r.rule},
+                    {"order", transfer.order},
+                    {"coefficients", transfer.coefficients},
+                    {"channels", transfer.channels},
+                    {"kind", transfer_kind_name(transfer.kind)},
+                    {"model", transfer_model_name(transfer.model)},
+                    {"bounces", transfer.bounces},
+                    {"vertices", r.vertices},
+                    {"triangles", r.triangles},
+                    {"rays", r.rays},
+                    {"bounce_rays", r.bounce_rays},
+                    {"seconds", r.seconds},
+                    {"trace_seconds", r.trace_seconds},
+                    {"bounce_seconds", r.bounce_seconds}});
+        return;
+    }
+    info("baked {} transfer (order {}, {} coefficients{}) of {} vertices with {} on {}: {} rays{} in {:.2f} s; "
+         "wrote {} and {}",
+         transfer_kind_name(transfer.kind), transfer.order, transfer.coefficients,
+         transfer.channels == 3 ? " x RGB" : "", r.vertices, r.rule, r.backend, r.rays,
+         r.bounce_rays ? fmt::format(" + {} bounce rays", r.bounce_rays) : std::string(), r.seconds, o.output,
+         prt_sidecar_path(o.output).string());
+}
+
+} // namespace
+
+void add_prt_bake(CLI::App& group) {
+    auto o = std::make_shared<BakeOpts>();
+    auto* sub = group.add_subcommand("bake", "Bake per-vertex diffuse SH transfer vectors (PRT)");
+    sub->add_option("input", o->input, "Input mesh (any format 'mesh info' reads)")->required();
+    sub->add_option("-o,--output", o->output,
+                    "Output mesh (.glb or .ply) with attributes prt_0... and albedo; a sidecar OUTPUT.prt.json "
+                    "beside it")
+        ->required();
+    sub->add_option("--order", o->order, "Highest SH band l (coefficients: (l+1)^2)")
+        ->check(integer_in(0, kPrtMaxOrder))
+        ->capture_default_str();
+    sub->add_option("--kind", o->kind, "unshadowed, shadowed or interreflected")->capture_default_str();
+    sub->add_option("--bounces", o->bounces, "Interreflection bounces (implies --kind interreflected)")
+        ->check(integer_in(0, 16));
+    sub->add_option("--rule", o->rule,
+                    "Sphere rule, e.g. lebedev:590, design:t21; +rotate for a per-vertex "
+                    "rotation")
+        ->capture_default_str();
+    sub->add_option("--device", o->device, "Where the bake runs: cpu, or cuda")->capture_default_str();
+    sub->add_option("--backend", o->backend, "Visibility backend: embree (default on the CPU), brute or cuda");
+    sub->add_option("--albedo", o->albedo,
+                    "Linear RGB albedo, one or three numbers in [0, 1] (default: the vertex colours, else 0.8)");
+    sub->add_option("--model", o->model,
+                    "prt (the transfer integral) or shading-coefficient (the seed's A times the unshadowed "
+                    "irradiance)")
+        ->capture_default_str();
+    sub->add_option("--max-distance", o->max_distance, "Ignore occluders further than this, in mesh units")
+        ->check(real_in(0.0, 1e30, "mesh units", End::Open));
+    add_json_flag(*sub, o->json);
+    sub->callback([o, sub] { run(*o, *sub); });
+}
+
+SKYBAKE_CLI_COMMAND("prt", add_prt_bake)
+
+} // namespace skybake::cli

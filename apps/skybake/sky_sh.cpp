@@ -1,0 +1,85 @@
+// skybake sky sh [--model W.json | --preset P | --atmosphere A.json] --sun-elevation-deg E [--sun-azimuth-deg A]
+//                [--altitude-km H] [--order L] [--rule R] [--device D] -o light.json [--json]
+// The sky as RGB spherical harmonics, for PRT relighting (skybake/prt.h).
+#include <chrono>
+
+#include "commands.h"
+#include "flags.h"
+#include "sky_common.h"
+#include "skybake/files.h"
+#include "skybake/prt.h"
+#include "skybake/sky_source.h"
+
+namespace skybake::cli {
+
+void add_sky_sh(CLI::App& group) {
+    auto* sub = group.add_subcommand("sh", "Project the sky onto spherical harmonics (RGB) for PRT relighting");
+    struct Opts {
+        AtmosphereFlags atm;
+        ModelFlag model;
+        std::string output, rule = "lebedev:2030", device = "cpu";
+        double elevation = 30.0, azimuth = 0.0, altitude = 0.0;
+        int order = 3;
+        bool json = false;
+    };
+    auto o = std::make_shared<Opts>();
+    o->atm.add(*sub);
+    o->model.add(*sub);
+    sub->add_option("--sun-elevation-deg", o->elevation, "Sun above the horizon, degrees")
+        ->check(real_in(-90.0, 90.0, "degrees"))
+        ->capture_default_str();
+    sub->add_option("--sun-azimuth-deg", o->azimuth, "Sun azimuth, degrees: 0 towards +z, 90 towards +x")
+        ->check(real_in(-360.0, 360.0, "degrees"))
+        ->capture_default_str();
+    sub->add_option("--altitude-km", o->altitude, "Observer above the ground, km")
+        ->check(real_in(0.0, 1e6, "km"))
+        ->capture_default_str();
+    sub->add_option("--order", o->order, "Highest SH band l (coefficients: (l+1)^2)")
+        ->check(integer_in(0, kPrtMaxOrder))
+        ->capture_default_str();
+    sub->add_option("--rule", o->rule, "Sphere rule of the projection (see 'sphere list')")->capture_default_str();
+    sub->add_option("--device", o->device, "cpu or cuda (the sky's evaluation)")->capture_default_str();
+    sub->add_option("-o,--output", o->output, "Light JSON file (order, RGB coefficients, sun)")->required();
+    add_json_flag(*sub, o->json);
+    sub->callback([o, sub] {
+        check_output_path(o->output, {".json"}, "--output");
+        const SphereRule rule = parse_flag("--rule", [&] { return parse_rule(o->rule); });
+        if (rule.kind == RuleKind::Phong)
+            throw UsageError(fmt::format("'{}' integrates against a Phong lobe; use a lebedev, design, fibonacci or "
+                                         "mc rule",
+                                         rule.spec),
+                             "--rule");
+        const Device device = parse_flag("--device", [&] { return parse_device(o->device); });
+        const bool neural = o->model.active();
+        const SkySource sky = neural ? SkySource::network(o->model.load(*sub, o->atm), device)
+                                     : SkySource::reference(SkyModel(o->atm.load(*sub)), SkyMethod::Tables, device);
+        SkyLightSettings s;
+        s.sun_elevation_deg = o->elevation;
+        s.sun_azimuth_deg = o->azimuth;
+        s.altitude_km = o->altitude;
+        const SkyProjector projector(o->order, rule);
+        const auto t0 = std::chrono::steady_clock::now();
+        const ShLight light = projector.project(sky, s);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const std::string text = light_json(light, neural ? "network" : "reference", rule.spec);
+        write_stream_atomic(o->output, [&](std::ostream& out) { out << text; });
+        if (o->json) {
+            print_json({{"output", o->output},
+                        {"order", light.order},
+                        {"rule", rule.spec},
+                        {"source", sky.method_name()},
+                        {"seconds", seconds},
+                        {"L00", {light.coeffs[0].x, light.coeffs[0].y, light.coeffs[0].z}},
+                        {"sun_irradiance", {light.sun_irradiance.x, light.sun_irradiance.y, light.sun_irradiance.z}}});
+            return;
+        }
+        info("sky ({}) at sun elevation {} deg, altitude {} km -> order {} SH with {} ({} points) in {:.2f} ms; "
+             "wrote {}",
+             sky.method_name(), o->elevation, o->altitude, light.order, rule.spec, rule.size(), seconds * 1e3,
+             o->output);
+    });
+}
+
+SKYBAKE_CLI_COMMAND("sky", add_sky_sh)
+
+} // namespace skybake::cli

@@ -1,0 +1,353 @@
+// skybake/prt.h: precomputed radiance transfer (PRT) of a baked mesh, lit by
+// a low-frequency light in spherical harmonics: the sky, a map, a constant.
+//
+// Sloan, Kautz & Snyder, Precomputed Radiance Transfer for Real-Time Rendering
+// in Dynamic, Low-Frequency Lighting Environments, SIGGRAPH 2002; seed 002
+// (Svistunov) for the visibility words and the simplified B ≈ A · B̃;
+// Ramamoorthi & Hanrahan 2001 for the irradiance convolution.
+//
+// [SECTION] Definitions
+// [SECTION] Transfer bake
+// [SECTION] Light
+// [SECTION] Relighting
+// [SECTION] Glossy transfer (DPRT)
+// [SECTION] Shader export
+// [SECTION] Files
+//
+// See docs/prt.md for the maths, the files, the measured errors and the
+// command line (`skybake prt bake`, `skybake prt relight`, `skybake sky sh`).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/mat3x3.hpp>
+#include <glm/vec3.hpp>
+
+#include "skybake/bake.h"
+#include "skybake/image.h"
+#include "skybake/mesh.h"
+#include "skybake/neural.h"
+#include "skybake/sh.h"
+#include "skybake/sky_source.h"
+#include "skybake/sphere.h"
+#include "skybake/visibility.h"
+
+namespace skybake {
+
+// [SECTION] Definitions -------------------------------------------------------------
+//
+// Light: distant radiance L(x) (x a unit direction, world space) as real SH
+// (skybake/sh.h) per RGB channel, L(x) = Σ_lm L_lm Y_lm(x), with
+// L_lm = ∫ L Y_lm dω.
+//
+// Diffuse transfer of vertex p with unit normal n, for the normalised measure
+// dμ = dω/4π and the seed's cosine weight 4 (n·x)+:
+//     T_lm = ∫ Y_lm(x) V_p(x) 4 (n·x)+ dμ = (1/π) ∫ Y_lm V (n·x)+ dω,
+// so that the outgoing radiance of a Lambertian surface of albedo ρ is
+//     B = ρ (1/π) ∫ L V (n·x)+ dω = ρ Σ_lm L_lm T_lm      (per channel).
+// A sphere rule {x_k, w_k} replaces the integral: T_lm = Σ_k w_k 4 (n·x_k)+ V_k Y_lm(x_k).
+// Kinds (TransferKind):
+//   unshadowed      V ≡ 1 above the horizon. Analytically
+//                   T_lm = (Â_l / π) Y_lm(n), Â_l the clamped-cosine factors
+//                   (Ramamoorthi & Hanrahan 2001; clamped_cosine_zonal()).
+//   shadowed        V from the visibility words of the bake (skybake/visibility.h).
+//   interreflected  shadowed plus N bounces (Sloan 2002, section 5): an
+//                   occluded direction x_k brings the light the surface it hits
+//                   sends back, B_hit = ρ_hit Σ L_lm T_lm(hit), with T at the hit
+//                   interpolated from its triangle's vertices:
+//                       T^(b)_lm(p) = T^(0)_lm(p) + Σ_k w_k 4 (n·x_k)+ (1 − V_k) ρ_hit T^(b−1)_lm(hit).
+//                   Every ray is answered by RayQueries::intersect(). Per RGB
+//                   channel, because ρ_hit is coloured; albedo ρ_p is not
+//                   included (B = ρ_p Σ L T as before).
+// With constant light L (L_00 = 2√π L, the rest 0), B = ρ L · 2√π Y_00 T_00 =
+// ρ L Σ_k w_k 4 (n·x_k)+ V_k = ρ L · AO: the shadowed transfer's first
+// coefficient is the ambient occlusion of skybake/bake.h times 2√π.
+//
+// Model (TransferModel):
+//   prt                  the transfer above;
+//   shading-coefficient  the seed's simplified form B ≈ A · B̃ with B̃ the
+//                        unshadowed irradiance: T_lm = A (Â_l / π) Y_lm(n),
+//                        A the shading coefficient (skybake/bake.h).
+//
+// Frames: world space of the mesh. The sky's zenith is +y (the glTF up axis);
+// sun azimuth 0 is towards +z, 90° towards +x.
+
+enum class TransferKind : int { Unshadowed = 0, Shadowed = 1, Interreflected = 2 };
+enum class TransferModel : int { Prt = 0, ShadingCoefficient = 1 };
+// "unshadowed", "shadowed", "interreflected"; "prt", "shading-coefficient".
+const char* transfer_kind_name(TransferKind kind);
+const char* transfer_model_name(TransferModel model);
+// Throw skybake::Error (where: "kind" / "model") listing the names.
+TransferKind parse_transfer_kind(const std::string& text);
+TransferModel parse_transfer_model(const std::string& text);
+
+// Highest SH band a transfer bake takes (81 coefficients).
+inline constexpr int kPrtMaxOrder = 8;
+
+// [SECTION] Transfer bake ---------------------------------------------------------------
+
+struct TransferOptions {
+    int order = 3; // lmax, 0 ... kPrtMaxOrder: (order + 1)² coefficients
+    TransferKind kind = TransferKind::Shadowed;
+    TransferModel model = TransferModel::Prt;
+    int bounces = 0; // interreflected only: ≥ 1 (and ≤ 16)
+};
+
+// Per-vertex transfer vectors. coeffs holds vertices × channels × coefficients
+// floats: vertex v, channel c (0 for grey transfer, else R, G, B), coefficient
+// i = sh_index(l, m) at (v · channels + c) · coefficients + i.
+struct Transfer {
+    int order = 3;
+    int coefficients = 16; // sh_count(order)
+    int channels = 1;      // 1 (unshadowed, shadowed), 3 (interreflected)
+    TransferKind kind = TransferKind::Shadowed;
+    TransferModel model = TransferModel::Prt;
+    int bounces = 0;
+    std::string rule; // canonical rule spec of the bake
+    std::vector<float> coeffs;
+    // The shading coefficient A of every vertex, from the same bits (seed 002;
+    // skybake/bake.h): the glossy factor of B ≈ A · B̃ (DPRT). Empty when unknown.
+    std::vector<float> shading;
+
+    std::size_t vertices() const { return coeffs.size() / std::size_t(channels * coefficients); }
+    const float* vertex(std::size_t v, int channel = 0) const {
+        return coeffs.data() + (v * std::size_t(channels) + std::size_t(channel)) * std::size_t(coefficients);
+    }
+};
+
+// The reduction of the visibility words into diffuse transfer (shadowed or, with
+// kind Unshadowed, ignoring the words; see [SECTION] Definitions). Use it with
+// bake_visibility() like ShadingReduction; `out` gets one vector per vertex
+// (channels 1). Also keeps the shading coefficient A per vertex (for the
+// shading-coefficient model) and, with keep_words, the words (for bounces).
+class TransferReduction final : public VisibilityReduction {
+public:
+    TransferReduction(Transfer& out, bool keep_words = false);
+    void begin(const VisibilityRule& rule, std::size_t vertices) override;
+    std::uint64_t reduce(const VisibilityChunk& chunk) override;
+
+    const std::vector<float>& shading() const { return shading_; }
+    const std::vector<std::uint32_t>& words() const { return words_; }
+
+private:
+    Transfer& out_;
+    bool keep_words_;
+    VisibilityRule rule_;
+    std::vector<float> table_; // Y_i(points[j]) at j · coefficients + i, when the rule does not rotate
+    std::vector<float> shading_;
+    std::vector<std::uint32_t> words_;
+};
+
+struct TransferReport {
+    std::string backend, rule;
+    std::size_t vertices = 0, triangles = 0, directions = 0;
+    std::uint64_t rays = 0;        // visibility rays
+    std::uint64_t bounce_rays = 0; // closest-hit rays: one per occluded direction, reused by every bounce
+    double seconds = 0.0, trace_seconds = 0.0, bounce_seconds = 0.0;
+    float ray_offset = 0.0f;
+};
+
+// Bakes the transfer of every vertex. rule: a sphere rule (not a Phong rule);
+// albedo: one linear RGB reflectance in [0, 1] per vertex (mesh.vertex_count()
+// entries), used by the bounces only (may be empty otherwise); queries: a
+// backend that answers ray queries, required for interreflected transfer
+// (nullptr otherwise). Computes normals when the mesh has none. Throws
+// skybake::Error naming the field: "order", "bounces", "kind", "albedo",
+// "backend" (bounces without ray queries), and those of bake_visibility().
+TransferReport bake_transfer(Mesh& mesh, const SphereRule& rule, VisibilityTracer& tracer, const BakeOptions& bake,
+                             const TransferOptions& options, std::span<const glm::vec3> albedo, RayQueries* queries,
+                             Transfer& out);
+
+// The mesh's albedo for PRT: its vertex colours (RGB) when it has them, else
+// `fallback` for every vertex.
+std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const glm::vec3& fallback = glm::vec3(0.8f));
+
+// [SECTION] Light ----------------------------------------------------------------------------
+
+// RGB radiance in SH: coeffs[sh_index(l, m)] = L_lm, sh_count(order) entries.
+// Radiance in the source's unit (the sky: per unit sun irradiance, 1/sr).
+struct ShLight {
+    int order = 3;
+    std::vector<glm::vec3> coeffs;
+    // The sun as a direct light (not in the SH): direction (unit, world
+    // space, towards the sun) and irradiance on a surface facing it (the
+    // transmitted sun; zero when there is no sun or it is below the ground).
+    glm::vec3 sun_direction{0.0f, 1.0f, 0.0f};
+    glm::vec3 sun_irradiance{0.0f};
+};
+
+// Constant radiance in every direction: L_00 = 2√π · radiance.
+ShLight constant_light(const glm::vec3& radiance, int order);
+// c_lm = 4π Σ_k w_k f(x_k) Y_lm(x_k) per channel, with a sphere rule (not a
+// Phong rule). Exact for f band-limited to l_f when the rule's precision is
+// ≥ l_f + order.
+ShLight project_light(const std::function<glm::vec3(const glm::vec3&)>& radiance, int order, const SphereRule& rule);
+// An equirectangular map (the sample_equirect() layout of skybake/sh.h), its
+// +z pole turned to the world's +y zenith: world direction (x, y, z) reads
+// the map at (x, −z, y), so the top row is the zenith. Throws skybake::Error (where: "light") on an
+// empty map or one that is not 2:1 within a pixel, or with non-finite pixels.
+ShLight equirect_light(const Image& map, int order, const SphereRule& rule);
+// The light turned by `rotation` (g(x) = f(rotationᵀ x), Ivanic–Ruedenberg).
+ShLight rotate_light(const ShLight& light, const glm::mat3& rotation);
+
+struct SkyLightSettings {
+    double sun_elevation_deg = 30.0; // above the horizon, degrees
+    double sun_azimuth_deg = 0.0;    // 0: towards +z, 90: towards +x
+    double altitude_km = 0.0;        // observer above the ground, ≥ 0
+    bool sun = true;                 // fill ShLight::sun_* (the transmitted sun)
+};
+
+// World direction (unit, +y up) of a sun at this elevation and azimuth.
+glm::vec3 sun_direction(double elevation_deg, double azimuth_deg);
+
+// The sky seen from altitude_km, with the sun at (elevation, azimuth): its
+// radiance per unit sun irradiance (SkySource::evaluate), above and below the
+// horizon (below: the light scattered between the observer and the ground;
+// the ground itself is not included), projected with `rule`. The sun is a
+// direct light: sun_irradiance = the atmosphere's sun irradiance times the
+// transmittance exp(−Σ_k β_k t_k) along the sun ray, t_k from the
+// optical-length tables (zero once the sun is below the ground). Throws
+// skybake::Error (where: "altitude_km", "sun_elevation_deg", "order").
+ShLight sky_light(const SkySource& sky, const SkyLightSettings& settings, int order, const SphereRule& rule);
+
+// Reusable sky projection for per-frame updates: the rule's SH table and
+// samples are built once; project() then evaluates the sky and sums.
+class SkyProjector {
+public:
+    SkyProjector(int order, const SphereRule& rule);
+    ShLight project(const SkySource& sky, const SkyLightSettings& settings) const;
+    int order() const { return order_; }
+
+private:
+    int order_;
+    std::vector<glm::vec3> points_;
+    std::vector<float> weighted_table_; // 4π w_k Y_i(x_k) at k · coefficients + i
+};
+
+// Sun transmittance (per channel) from altitude_km towards a sun with
+// cos_sun_zenith, from the optical-length tables; 0 when the ray meets the ground.
+glm::dvec3 sun_transmittance(const SkyModel& tables, double altitude_km, double cos_sun_zenith);
+
+// [SECTION] Relighting -----------------------------------------------------------------------
+
+// Outgoing radiance of every vertex, B_v = ρ_v Σ_lm L_lm T_lm(v) (per channel;
+// the grey transfer is shared by the three channels), plus the sun:
+// ρ_v (1/π) (n·s)+ E_sun sun_visible[v]. The light must have at least the
+// transfer's order (higher bands are ignored). albedo: vertex_count entries;
+// normals and sun_visible: empty to leave out the sun, else vertex_count
+// entries (sun_visible: 1 lit, 0 shadowed). Throws skybake::Error (where:
+// "light", "albedo").
+std::vector<glm::vec3> relight(const Transfer& transfer, const ShLight& light, std::span<const glm::vec3> albedo,
+                               std::span<const glm::vec3> normals = {}, std::span<const float> sun_visible = {});
+
+// Per-vertex visibility of the sun (1 or 0) by one occlusion ray per vertex
+// from the bake's ray origin.
+std::vector<float> sun_visibility(const Mesh& mesh, const glm::vec3& sun_direction, RayQueries& queries);
+
+// [SECTION] Glossy transfer (DPRT) ------------------------------------------------------------
+//
+// Svistunov's DPRT (seed 002): for the normalised Phong lobe of exponent a,
+// ρ_a(r·x) = 2(a + 1) max(r·x, 0)^a around the mirror direction r = 2(n·v)n − v
+// of the view v (unit, from the surface towards the eye) about the unit normal n,
+//     B̃(v) = ∫ L(x) ρ_a(r·x) dμ ≈ Σ_k λ_k L(g_nv x_k),
+// with {x_k, λ_k} a Phong rule (phong_rule(), lobe axis +z) and g_nv a rotation
+// taking +z to r. The glossy radiance is then B(v) ≈ A · B̃(v) (A: the shading
+// coefficient). Exact for L a polynomial of degree ≤ 2N − 1 (N: the rule's
+// nodes in cos θ); the lobe's own degree does not enter, the rule's weights
+// carry it. For an SH light the exact value is also Σ_lm k_l L_lm Y_lm(r) with
+// k_l = 2(a+1)/(4π) · phong_lobe_zonal(l, a) (Funk–Hecke).
+
+// A rotation (columns: tangent, bitangent, axis) taking +z to the unit `axis`.
+glm::mat3 frame_from_axis(const glm::vec3& axis);
+// The mirror direction 2(n·v)n − v.
+glm::vec3 mirror_direction(const glm::vec3& normal, const glm::vec3& view);
+
+// Σ_k λ_k L(g_nv x_k) for any light L (the SH light, or the sky evaluated
+// directly). phong: a Phong rule; normal, view: unit, world space.
+glm::vec3 dprt_glossy(const SphereRule& phong, const std::function<glm::vec3(const glm::vec3&)>& radiance,
+                      const glm::vec3& normal, const glm::vec3& view);
+// Same for an SH light (evaluated at each turned direction).
+glm::vec3 dprt_glossy(const SphereRule& phong, const ShLight& light, const glm::vec3& normal, const glm::vec3& view);
+// The exact Phong integral of an SH light by Funk–Hecke (the reference).
+glm::vec3 phong_glossy_exact(const ShLight& light, double exponent_a, const glm::vec3& normal, const glm::vec3& view);
+
+// An image of a relit model through the ray-cast preview of skybake/bake.h
+// (render_ao_preview()'s camera): each hit gets the per-vertex `diffuse`
+// radiance (mesh.vertex_count() entries, e.g. from relight()) interpolated,
+// plus, when phong_exponent > 0, the DPRT glossy term
+//     specular · A · Σ_k λ_k L(g_nv x_k)
+// per pixel, with the normal and the shading coefficient A interpolated
+// (A = 1 when the transfer has none), v towards the eye, and the Phong rule
+// phong:a=exponent,n=order/2+1 (exact for the light's degree). A miss shows
+// the SH light along the ray (clamped at 0). Linear radiance.
+Image render_prt_preview(const Mesh& mesh, const Transfer& transfer, std::span<const glm::vec3> diffuse,
+                         const ShLight& light, double phong_exponent, float specular,
+                         const AoPreviewOptions& options = {});
+
+// [SECTION] Shader export --------------------------------------------------------------------
+//
+// GLSL for engines (any GLSL ≥ 3.30 or ES 3.00, vertex or fragment shader):
+//   vec3 NAME_diffuse(vec4 prt[M], vec3 light[C], vec3 albedo)
+//       B = albedo Σ_i light[i] t_i for a grey transfer (channels 1), or per
+//       channel for RGB transfer; prt[] the attributes _PRT_0 ... _PRT_{M-1}
+//       in order, light[] the SH light (the "coefficients" of a light file).
+//   vec3 NAME_glossy(vec3 n, vec3 v, vec3 sun, float density)   (with a network)
+//       DPRT with the sky network evaluated directly: Σ_k λ_k sky(g_nv x_k),
+//       the Phong rule's points and weights unrolled as constants; n, v, sun
+//       unit, world space (+y up); density as SkySample::density. Multiply by
+//       the shading coefficient (attribute _SHADING) and the sun irradiance.
+//       The network's own function (export_neural_sky(), named NAME_sky) is
+//       included.
+struct PrtShaderOptions {
+    std::string function_name = "skybake_prt";
+    const SphereRule* phong = nullptr; // a Phong rule: adds NAME_glossy (needs network)
+    const NeuralSky* network = nullptr;
+};
+std::string export_prt_glsl(int order, int channels, const PrtShaderOptions& options = {});
+
+// [SECTION] Files ------------------------------------------------------------------------------
+//
+// A baked mesh carries its transfer as attributes "prt_0", "prt_1", ... of 4
+// components (glTF "_PRT_0", ...; PLY prt_0_x ... prt_0_w): the
+// channels × coefficients floats of each vertex in order, zero-padded to a
+// multiple of 4; "albedo" (3 components, linear RGB); "shading" (1
+// component, the shading coefficient A, when the transfer has it). A JSON sidecar beside
+// it (OUT.glb → OUT.prt.json) says how to read them:
+//   {"format": "skybake-prt", "version": 1, "order": 3, "coefficients": 16,
+//    "channels": 1, "kind": "shadowed", "model": "prt", "bounces": 0,
+//    "rule": "lebedev:590", "albedo": "vertex-colors" | [r, g, b],
+//    "vertices": 1234, "attributes": ["prt_0", ...]}
+
+// OUT.glb → OUT.prt.json.
+std::filesystem::path prt_sidecar_path(const std::filesystem::path& mesh_path);
+// Stores the transfer and the albedo on the mesh as attributes.
+void set_transfer_attributes(Mesh& mesh, const Transfer& transfer, std::span<const glm::vec3> albedo);
+// The sidecar's JSON text. albedo_source: "vertex-colors", or the constant
+// albedo as a JSON array "[r, g, b]" (stored as an array).
+std::string transfer_sidecar_json(const Transfer& transfer, std::size_t vertices, const std::string& albedo_source);
+
+// Light file (`skybake sky sh`):
+//   {"format": "skybake-sh-light", "version": 1, "order": 3,
+//    "coefficients": [[r, g, b], ...]  ((order + 1)² of them, sh_index order),
+//    "sun_direction": [x, y, z], "sun_irradiance": [r, g, b],
+//    "source": "reference" | "network" | ..., "rule": "lebedev:590"}
+std::string light_json(const ShLight& light, const std::string& source, const std::string& rule);
+// Throws skybake::Error (where: "light") for a missing, corrupt or inconsistent file.
+ShLight load_light(const std::filesystem::path& path);
+
+struct PrtModel {
+    Mesh mesh;
+    Transfer transfer;
+    std::vector<glm::vec3> albedo;
+};
+// Reads a mesh written with its sidecar. Throws skybake::Error (where:
+// "sidecar") for a missing, corrupt or mismatched sidecar (wrong format,
+// order, vertex count or attributes).
+PrtModel load_prt(const std::filesystem::path& mesh_path);
+
+} // namespace skybake

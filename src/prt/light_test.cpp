@@ -1,0 +1,186 @@
+// Light in SH (skybake/prt.h, [SECTION] Light): constant, projected, rotated,
+// equirectangular, and the sky against a dense reference projection.
+#include <cmath>
+#include <random>
+
+#include <glm/geometric.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <gtest/gtest.h>
+
+#include "skybake/error.h"
+#include "skybake/prt.h"
+
+namespace skybake {
+namespace {
+
+TEST(Light, ConstantLightIsItsOwnProjection) {
+    const ShLight c = constant_light(glm::vec3(1.0f, 2.0f, 3.0f), 4);
+    const ShLight p =
+        project_light([](const glm::vec3&) { return glm::vec3(1.0f, 2.0f, 3.0f); }, 4, parse_rule("lebedev:p17"));
+    ASSERT_EQ(c.coeffs.size(), 25u);
+    for (std::size_t i = 0; i < c.coeffs.size(); ++i)
+        for (int ch = 0; ch < 3; ++ch)
+            EXPECT_NEAR(c.coeffs[i][ch], p.coeffs[i][ch], 2e-5) << i;
+    EXPECT_NEAR(glm::vec3(sh_evaluate(std::vector<glm::dvec3>(c.coeffs.begin(), c.coeffs.end()), 4,
+                                      glm::dvec3(0.3, 0.4, std::sqrt(0.75))))
+                    .y,
+                2.0f, 1e-5);
+}
+
+TEST(Light, ProjectionOfABandLimitedLightIsExact) {
+    // f = a band-3 polynomial; a rule of precision ≥ 3 + 4 projects it exactly.
+    auto f = [](const glm::vec3& x) { return glm::vec3(1.0f + x.x * x.y * x.z, x.y * x.y, 0.5f - x.z); };
+    const ShLight p = project_light(f, 4, parse_rule("lebedev:p7"));
+    std::vector<glm::dvec3> c(p.coeffs.begin(), p.coeffs.end());
+    for (const glm::dvec3 x : {glm::dvec3(0, 0, 1), glm::normalize(glm::dvec3(1, 2, -3)), glm::dvec3(0, -1, 0)}) {
+        const glm::dvec3 got = sh_evaluate(c, 4, x), want = glm::dvec3(f(glm::vec3(x)));
+        EXPECT_LT(glm::length(got - want), 1e-5);
+    }
+}
+
+TEST(Light, RotationTurnsTheLight) {
+    auto f = [](const glm::vec3& x) { return glm::vec3(x.x * x.x + x.y, 1.0f + x.z, x.x * x.y); };
+    const SphereRule rule = parse_rule("lebedev:p9");
+    const ShLight l = project_light(f, 2, rule);
+    const glm::mat3 r(glm::rotate(glm::mat4(1.0f), 0.7f, glm::normalize(glm::vec3(1, 2, 3))));
+    const ShLight turned = rotate_light(l, r);
+    std::vector<glm::dvec3> c(turned.coeffs.begin(), turned.coeffs.end());
+    for (const glm::vec3 x : {glm::vec3(0, 0, 1), glm::normalize(glm::vec3(1, -2, 0.5f))}) {
+        const glm::dvec3 got = sh_evaluate(c, 2, glm::dvec3(r * x));
+        EXPECT_LT(glm::length(got - glm::dvec3(f(x))), 1e-5);
+    }
+}
+
+TEST(Light, EquirectangularMap) {
+    // A map brighter towards the world zenith (+y), i.e. its top rows.
+    Image map(64, 32);
+    for (int j = 0; j < map.height; ++j)
+        for (int i = 0; i < map.width; ++i) {
+            const float z = std::cos(float(M_PI) * (float(j) + 0.5f) / float(map.height));
+            float* p = map.pixel(i, j);
+            p[0] = p[1] = p[2] = 1.0f + z;
+        }
+    const ShLight l = equirect_light(map, 2, parse_rule("lebedev:590"));
+    // 1 + y: L_00 = 2√π, L_1,-1 (the y band) = √(4π/3); the rest ≈ 0.
+    EXPECT_NEAR(l.coeffs[0].x, 2.0 * std::sqrt(M_PI), 2e-2);
+    EXPECT_NEAR(l.coeffs[sh_index(1, -1)].x, std::sqrt(4.0 * M_PI / 3.0), 2e-2);
+    EXPECT_NEAR(l.coeffs[sh_index(1, 0)].x, 0.0, 1e-3);
+    EXPECT_NEAR(l.coeffs[sh_index(1, 1)].x, 0.0, 1e-3);
+    // Not a map: wrong aspect, empty, negative.
+    auto where = [](const Image& img) -> std::string {
+        try {
+            equirect_light(img, 2, parse_rule("lebedev:50"));
+        } catch (const Error& e) {
+            return e.where();
+        }
+        return "no error";
+    };
+    EXPECT_EQ(where(Image(32, 32)), "light");
+    EXPECT_EQ(where(Image()), "light");
+    Image bad(8, 4);
+    bad.rgb[5] = -1.0f;
+    EXPECT_EQ(where(bad), "light");
+}
+
+TEST(Light, SunDirection) {
+    const glm::vec3 s = sun_direction(30.0, 90.0);
+    EXPECT_NEAR(s.y, 0.5f, 1e-6f);
+    EXPECT_NEAR(s.x, std::sqrt(0.75f), 1e-6f);
+    EXPECT_NEAR(s.z, 0.0f, 1e-6f);
+}
+
+class SkyLight : public ::testing::Test {
+protected:
+    static SkySource& sky() {
+        static SkySource s = SkySource::reference(SkyModel(atmosphere_preset("earth")));
+        return s;
+    }
+};
+
+TEST_F(SkyLight, TransmittanceRedAtSunsetAndZeroBelowTheGround) {
+    const SkyModel& m = sky().tables();
+    const glm::dvec3 noon = sun_transmittance(m, 0.0, 1.0), low = sun_transmittance(m, 0.0, 0.05);
+    EXPECT_GT(noon.z, 0.5);
+    EXPECT_LT(low.z / low.x, noon.z / noon.x); // blue lost first
+    EXPECT_EQ(sun_transmittance(m, 0.0, -0.2), glm::dvec3(0.0));
+    // Against the exact optical lengths, straight up.
+    glm::dvec3 tau(0.0);
+    for (int k = 0; k < int(m.atmosphere().components.size()); ++k)
+        tau += m.atmosphere().components[std::size_t(k)].extinction_per_km *
+               optical_length_exact(m.atmosphere(), k, 0.0, 1.0);
+    const glm::dvec3 exact = glm::exp(-tau);
+    for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(noon[c] / exact[c], 1.0, 1e-2) << c;
+}
+
+// The sky is not band-limited: the Mie aureole around the sun and the
+// horizon put energy in high bands, which a coarse rule aliases into the low
+// coefficients. The error of each rule against lebedev:5810 is printed and
+// must fall as the rule grows; the band-limiting error (the sky against its
+// own order-4 SH) is printed too.
+TEST_F(SkyLight, RuleProjectionAgainstDenseReference) {
+    const int order = 4;
+    for (double elevation : {60.0, 5.0}) {
+        SkyLightSettings s;
+        s.sun_elevation_deg = elevation;
+        const ShLight dense = sky_light(sky(), s, order, parse_rule("lebedev:5810"));
+        double previous = 1e30;
+        for (const char* spec : {"lebedev:194", "lebedev:590", "lebedev:2030"}) {
+            const ShLight fast = sky_light(sky(), s, order, parse_rule(spec));
+            double diff = 0.0, norm = 0.0;
+            for (std::size_t i = 0; i < dense.coeffs.size(); ++i) {
+                diff += double(glm::dot(dense.coeffs[i] - fast.coeffs[i], dense.coeffs[i] - fast.coeffs[i]));
+                norm += double(glm::dot(dense.coeffs[i], dense.coeffs[i]));
+            }
+            const double rel = std::sqrt(diff / norm);
+            std::printf("sky at %.0f deg, order %d: %s against lebedev:5810: %.3g relative (coefficient norm)\n",
+                        elevation, order, spec, rel);
+            EXPECT_LT(rel, previous) << spec;
+            previous = rel;
+        }
+        EXPECT_LT(previous, 0.08) << "lebedev:2030";
+        // The band-limiting error: the sky itself against its order-4 SH, as an
+        // RMS over lebedev:1202, relative to the RMS radiance.
+        const SphereRule probe = parse_rule("lebedev:1202");
+        std::vector<glm::dvec3> c(dense.coeffs.begin(), dense.coeffs.end());
+        const glm::vec3 sun = sun_direction(elevation, 0.0);
+        const float density = float(sky().atmosphere().density_from_altitude(0.0));
+        std::vector<SkySample> samples;
+        for (const glm::dvec3& x : probe.points)
+            samples.push_back(
+                {float(x.y), std::clamp(float(glm::dot(glm::dvec3(sun), x)), -1.0f, 1.0f), sun.y, density});
+        std::vector<glm::vec3> rad(samples.size());
+        sky().evaluate(samples, rad);
+        double err = 0.0, ref = 0.0;
+        for (std::size_t k = 0; k < probe.size(); ++k) {
+            const glm::dvec3 d = sh_evaluate(c, order, probe.points[k]) - glm::dvec3(rad[k]);
+            err += probe.weights[k] * glm::dot(d, d);
+            ref += probe.weights[k] * glm::dot(glm::dvec3(rad[k]), glm::dvec3(rad[k]));
+        }
+        std::printf("sky at %.0f deg: band-limiting RMS error of order %d: %.3g of the RMS radiance\n", elevation,
+                    order, std::sqrt(err / ref));
+        EXPECT_GT(dense.sun_irradiance.x, 0.0f);
+    }
+}
+
+TEST_F(SkyLight, BadSettings) {
+    SkyLightSettings s;
+    s.altitude_km = -1.0;
+    const SphereRule rule = parse_rule("lebedev:50");
+    try {
+        sky_light(sky(), s, 2, rule);
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_EQ(e.where(), "altitude_km");
+    }
+    s = {};
+    try {
+        sky_light(sky(), s, 2, parse_rule("phong:a=4,n=4"));
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_EQ(e.where(), "rule");
+    }
+}
+
+} // namespace
+} // namespace skybake
