@@ -71,12 +71,16 @@ void run(const BakeOpts& o, const CLI::App& sub) {
         throw UsageError("the shading-coefficient model has no bounces", "--bounces");
     const Device device = parse_flag("--device", [&] { return parse_device(o.device); });
     std::string backend = o.backend.empty() ? (device == Device::Cuda ? "cuda" : "embree") : o.backend;
-    if (backend != "embree" && backend != "brute" && backend != "cuda")
-        throw UsageError(fmt::format("unknown backend '{}'; use embree, brute or cuda", backend), "--backend");
+    if (backend != "embree" && backend != "brute" && backend != "cuda" && backend != "raster")
+        throw UsageError(fmt::format("unknown backend '{}'; use embree, brute, cuda or raster", backend), "--backend");
+    if (backend == "raster" && t.kind == TransferKind::Interreflected)
+        throw UsageError("interreflection needs closest hits, and the raster backend answers no ray queries; use "
+                         "--backend embree, brute or cuda",
+                         "--backend");
     const bool constant_albedo = !o.albedo.empty();
     const glm::vec3 albedo_value = constant_albedo ? parse_albedo(o.albedo) : glm::vec3(0.8f);
     check_output_path(o.output, {".glb", ".ply"}, "--output");
-    const auto tracer = make_visibility_tracer(backend);
+    const auto tracer = make_visibility_tracer(backend, default_trace_method(backend));
     std::unique_ptr<RayQueries> queries;
     if (t.kind == TransferKind::Interreflected)
         queries = make_ray_queries(backend);
@@ -89,6 +93,7 @@ void run(const BakeOpts& o, const CLI::App& sub) {
                         : (mesh.colors.size() == mesh.vertex_count() ? "vertex-colors" : "[0.8, 0.8, 0.8]");
     BakeOptions b;
     b.max_distance = float(o.max_distance);
+    b.method = tracer->method();
     Transfer transfer;
     const TransferReport r = bake_transfer(mesh, rule, *tracer, b, t, albedo, queries.get(), transfer);
     set_transfer_attributes(mesh, transfer, albedo);
@@ -149,7 +154,9 @@ void add_prt_bake(CLI::App& group) {
                     "rotation")
         ->capture_default_str();
     sub->add_option("--device", o->device, "Where the bake runs: cpu, or cuda")->capture_default_str();
-    sub->add_option("--backend", o->backend, "Visibility backend: embree (default on the CPU), brute or cuda");
+    sub->add_option("--backend", o->backend,
+                    "Visibility backend: embree (default on the CPU), brute, cuda or raster (the depth buffer; no "
+                    "bounces)");
     sub->add_option("--albedo", o->albedo,
                     "Linear RGB albedo, one or three numbers in [0, 1] (default: the vertex colours, else 0.8)");
     sub->add_option("--model", o->model,
