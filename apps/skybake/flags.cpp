@@ -183,6 +183,9 @@ std::string flag_for_field(const std::string& where) {
         {"name", "--name"},
         {"kind", "--kind"},
         {"target_triangles", "--triangles"},
+        {"texture_size", "--texture"},
+        {"uv_set", "--uv"},
+        {"dilate_texels", "--dilate"},
     };
     for (const auto& [field, flag] : kFields)
         if (where == field)

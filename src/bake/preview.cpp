@@ -10,14 +10,16 @@
 
 #include "skybake/bake.h"
 #include "skybake/error.h"
+#include "skybake/texture_bake.h"
 
 namespace skybake {
 
-Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
-    validate_mesh(mesh, "mesh");
-    const VertexAttribute* ao = mesh.find_attribute("ao");
-    if (!ao || ao->components != 1)
-        throw Error("the mesh has no baked 'ao' attribute to preview; bake it first", "mesh");
+namespace {
+
+// Casts the camera's rays and shades each hit with shade(triangle, u, v), a
+// linear colour.
+template <class Shade>
+Image render_preview(const Mesh& mesh, const AoPreviewOptions& o, const Shade& shade) {
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
         throw Error(fmt::format("preview size {}x{} is out of range; use 1 to 16384 pixels per side", o.width, o.height),
                     "width, height");
@@ -80,10 +82,7 @@ Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
                         sum += background;
                         continue;
                     }
-                    const std::uint32_t* tri = &mesh.indices[3 * std::size_t(h.triangle)];
-                    const float a = (1.0f - h.u - h.v) * ao->values[tri[0]] + h.u * ao->values[tri[1]] +
-                                    h.v * ao->values[tri[2]];
-                    sum += glm::vec3(srgb_to_linear(std::clamp(a, 0.0f, 1.0f)));
+                    sum += shade(h.triangle, h.u, h.v);
                 }
                 sum /= float(s * s);
                 float* p = img.pixel(x, y);
@@ -93,6 +92,52 @@ Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
             }
     }
     return img;
+}
+
+} // namespace
+
+Image render_ao_preview(const Mesh& mesh, const AoPreviewOptions& o) {
+    validate_mesh(mesh, "mesh");
+    const VertexAttribute* ao = mesh.find_attribute("ao");
+    if (!ao || ao->components != 1)
+        throw Error("the mesh has no baked 'ao' attribute to preview; bake it first", "mesh");
+    return render_preview(mesh, o, [&](std::uint32_t triangle, float u, float v) {
+        const std::uint32_t* tri = &mesh.indices[3 * std::size_t(triangle)];
+        const float a = (1.0f - u - v) * ao->values[tri[0]] + u * ao->values[tri[1]] + v * ao->values[tri[2]];
+        return glm::vec3(srgb_to_linear(std::clamp(a, 0.0f, 1.0f)));
+    });
+}
+
+Image render_texture_preview(const Mesh& mesh, const AoTexture& texture, int uv_set,
+                             const std::vector<Image>& base_colors, const AoPreviewOptions& o) {
+    validate_mesh(mesh, "mesh");
+    if (uv_set < 0 || std::size_t(uv_set) >= mesh.texcoords.size())
+        throw Error(fmt::format("the mesh has no UV set {} to read the texture with", uv_set), "uv_set");
+    if (texture.ao.size() != std::size_t(texture.texture_size) * std::size_t(texture.texture_size))
+        throw Error("the AO texture is empty; bake it first", "texture");
+    const std::vector<glm::vec2>& uvs = mesh.texcoords[std::size_t(uv_set)];
+    return render_preview(mesh, o, [&](std::uint32_t triangle, float u, float v) {
+        const std::uint32_t* tri = &mesh.indices[3 * std::size_t(triangle)];
+        const glm::vec2 uv = (1.0f - u - v) * uvs[tri[0]] + u * uvs[tri[1]] + v * uvs[tri[2]];
+        glm::vec3 albedo(0.8f);
+        if (!mesh.triangle_parts.empty()) {
+            const int m = mesh.parts[mesh.triangle_parts[triangle]].material;
+            if (m >= 0) {
+                const MeshMaterial& mat = mesh.materials[std::size_t(m)];
+                albedo = glm::vec3(mat.base_color);
+                if (std::size_t(m) < base_colors.size() && base_colors[std::size_t(m)].width > 0) {
+                    // Nearest texel of the base colour image (its own UV set is assumed to be uv_set's).
+                    const Image& img = base_colors[std::size_t(m)];
+                    const float fu = uv.x - std::floor(uv.x), fv = uv.y - std::floor(uv.y);
+                    const int x = std::clamp(int(fu * float(img.width)), 0, img.width - 1);
+                    const int y = std::clamp(int(fv * float(img.height)), 0, img.height - 1);
+                    const float* p = img.pixel(x, y);
+                    albedo *= glm::vec3(p[0], p[1], p[2]);
+                }
+            }
+        }
+        return albedo * std::clamp(sample_texture(texture, uv), 0.0f, 1.0f);
+    });
 }
 
 } // namespace skybake

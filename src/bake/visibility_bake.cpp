@@ -62,21 +62,19 @@ float resolve_ray_offset(const Mesh&, const BakeOptions& options) {
     return options.ray_offset > 0.0f ? options.ray_offset : 0.0f;
 }
 
-VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, VisibilityTracer& tracer,
-                                    const BakeOptions& options, VisibilityReduction& reduction) {
-    check_inputs(mesh, rule, options);
-    if (options.method != tracer.method())
-        throw Error(fmt::format("the {} method is not the {} tracer's (it has {}); create the tracer with the method",
-                                trace_method_name(options.method), tracer.name(), trace_method_name(tracer.method())),
-                    "method");
-    const auto n = std::uint32_t(mesh.vertex_count());
+namespace {
 
+// The loop itself, over n sample points whose ray frame frame(i, origin,
+// normal) gives: the mesh's vertices, or other points on its surface.
+template <class Frame>
+VisibilityBakeStats bake_points(const Mesh& mesh, std::uint32_t n, float ray_offset, const Frame& frame,
+                                const SphereRule& rule, VisibilityTracer& tracer, const BakeOptions& options,
+                                VisibilityReduction& reduction) {
     const bake::VisitingRule visit = bake::visiting_rule(rule);
     const std::uint32_t words = visit.words_per_vertex;
     const bool rotate = visit.rotate;
     VisibilityBakeStats stats;
-    const bake::VertexRays rays = bake::vertex_rays(mesh, options);
-    stats.ray_offset = rays.offset;
+    stats.ray_offset = ray_offset;
 
     const auto t0 = std::chrono::steady_clock::now();
     tracer.set_mesh(mesh, options.back_faces);
@@ -119,8 +117,7 @@ VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, Vi
         parallel_for(count, 1024, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) {
                 const std::size_t v = first + i;
-                chunk_normals[i] = rays.normals[v];
-                origins[i] = rays.origin(mesh, v);
+                frame(v, origins[i], chunk_normals[i]);
                 if (rotate)
                     rotations[i] = visit.rotation(std::uint32_t(v));
             }
@@ -149,6 +146,49 @@ VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, Vi
     progress.finish();
     stats.trace_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     return stats;
+}
+
+void check_method(const BakeOptions& options, const VisibilityTracer& tracer) {
+    if (options.method != tracer.method())
+        throw Error(fmt::format("the {} method is not the {} tracer's (it has {}); create the tracer with the method",
+                                trace_method_name(options.method), tracer.name(), trace_method_name(tracer.method())),
+                    "method");
+}
+
+} // namespace
+
+VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, VisibilityTracer& tracer,
+                                    const BakeOptions& options, VisibilityReduction& reduction) {
+    check_inputs(mesh, rule, options);
+    check_method(options, tracer);
+    const bake::VertexRays rays = bake::vertex_rays(mesh, options);
+    const auto frame = [&](std::size_t v, glm::vec3& origin, glm::vec3& normal) {
+        normal = rays.normals[v];
+        origin = rays.origin(mesh, v);
+    };
+    return bake_points(mesh, std::uint32_t(mesh.vertex_count()), rays.offset, frame, rule, tracer, options,
+                       reduction);
+}
+
+VisibilityBakeStats bake_visibility(const Mesh& mesh, const SamplePoints& points, const SphereRule& rule,
+                                    VisibilityTracer& tracer, const BakeOptions& options,
+                                    VisibilityReduction& reduction) {
+    check_inputs(mesh, rule, options);
+    check_method(options, tracer);
+    const std::size_t n = points.positions.size();
+    if (points.normals.size() != n || points.sizes.size() != n)
+        throw Error(fmt::format("{} sample positions, {} normals and {} sizes; they must be as many", n,
+                                points.normals.size(), points.sizes.size()),
+                    "points");
+    if (n >= std::size_t(0xffffffffu))
+        throw Error(fmt::format("{} sample points is too many; the bake handles up to 4,294,967,294", n), "points");
+    const float offset = resolve_ray_offset(mesh, options);
+    const auto frame = [&](std::size_t v, glm::vec3& origin, glm::vec3& normal) {
+        normal = points.normals[v];
+        origin = bake::ray_origin(points.positions[v], normal, glm::vec3(0.0f), offset,
+                                  bake::rounding_step(points.positions[v], points.sizes[v]));
+    };
+    return bake_points(mesh, std::uint32_t(n), offset, frame, rule, tracer, options, reduction);
 }
 
 namespace bake {
