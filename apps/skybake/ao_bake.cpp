@@ -340,10 +340,13 @@ void add_ao_bake(CLI::App& group) {
     sub->add_option("--texture", o->texture,
                     "Also bake AO into a texture of this many texels square over the mesh's UVs (16 to 16384), "
                     "wired as the glTF material's occlusionTexture");
-    sub->add_option("--uv", o->uv, "UV set (TEXCOORD_n) of the texture bake")->capture_default_str();
+    sub->add_option("--uv", o->uv, "UV set (TEXCOORD_n) of the texture bake")
+        ->check(integer_in(0, 7))
+        ->capture_default_str();
     sub->add_option("--texture-out", o->texture_out,
                     "The AO texture file: .png (16-bit grey) or .exr (default: OUTPUT's name + _ao.png)");
     sub->add_option("--dilate", o->dilate, "Gutter grown around the UV islands of the texture, texels")
+        ->check(integer_in(0, 256, "texels"))
         ->capture_default_str();
     add_json_flag(*sub, o->json);
     sub->callback([o, sub] { run(*o, *sub); });

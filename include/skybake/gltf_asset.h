@@ -41,6 +41,8 @@ namespace skybake {
 //     with the transpose of the node's linear transform and renormalised,
 //     the inverse of how NORMAL is carried to world space. Other attributes
 //     are scalars and are written as they are;
+//   - new or changed colours of mesh() (a bake's AO as grey) become
+//     COLOR_0 of the primitives that have none; a file's own COLOR_0 is kept;
 //   - asset.generator gets "skybake" appended;
 //   - with set_occlusion_texture(), one image and texture are appended, and
 //     the baked primitives' materials get an occlusionTexture;

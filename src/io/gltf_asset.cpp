@@ -117,6 +117,7 @@ struct GltfAsset::State {
     std::vector<std::vector<unsigned char>> buffers;
     std::vector<io::GltfPrimitiveInstance> instances;
     std::vector<VertexAttribute> loaded_attributes; // to tell new and changed ones
+    std::vector<glm::vec4> loaded_colors;
     Mesh mesh;
     ImportReport report;
     std::filesystem::path occlusion_image; // empty: none
@@ -188,6 +189,7 @@ GltfAsset GltfAsset::load(const std::filesystem::path& path, const ImportLimits&
     state->instances = std::move(map.instances);
     state->buffers = std::move(map.buffers);
     state->loaded_attributes = state->mesh.attributes;
+    state->loaded_colors = state->mesh.colors;
     try {
         state->document = Json::parse(binary ? glb_json(data, where) : data);
     } catch (const nlohmann::json::exception& e) {
@@ -225,6 +227,14 @@ void GltfAsset::save(const std::filesystem::path& path) const {
             fresh.push_back(&a);
     }
 
+    // New colours (a bake's AO as grey) as a four-component attribute.
+    VertexAttribute colors{"color", 4, {}};
+    if (!mesh.colors.empty() &&
+        (mesh.colors.size() != s.loaded_colors.size() ||
+         std::memcmp(mesh.colors.data(), s.loaded_colors.data(), mesh.colors.size() * sizeof(glm::vec4)) != 0))
+        for (const glm::vec4& c : mesh.colors)
+            colors.values.insert(colors.values.end(), {c.r, c.g, c.b, c.a});
+
     Json doc = s.document;
     if (!doc.contains("buffers") || !doc["buffers"].is_array() || doc["buffers"].empty() || s.buffers.empty())
         throw Error("the document has no buffer to append to", where);
@@ -258,7 +268,7 @@ void GltfAsset::save(const std::filesystem::path& path) const {
         }
         Json& prim = meshes[std::size_t(target_mesh[inst.node])]["primitives"][std::size_t(inst.primitive)];
         const glm::dmat3 mesh_from_world_normal = glm::transpose(inst.world_from_mesh);
-        for (const VertexAttribute* a : fresh) {
+        const auto append = [&](const VertexAttribute* a, const std::string& key) {
             const std::size_t c = std::size_t(a->components);
             local.assign(a->values.begin() + std::ptrdiff_t(inst.first_vertex * c),
                          a->values.begin() + std::ptrdiff_t((inst.first_vertex + inst.vertex_count) * c));
@@ -280,8 +290,13 @@ void GltfAsset::save(const std::filesystem::path& path) const {
                                  {"componentType", kFloat},
                                  {"count", inst.vertex_count},
                                  {"type", accessor_type(a->components)}});
-            prim["attributes"][gltf_attribute_name(a->name)] = accessors.size() - 1;
-        }
+            prim["attributes"][key] = accessors.size() - 1;
+        };
+        for (const VertexAttribute* a : fresh)
+            append(a, gltf_attribute_name(a->name));
+        // Baked colours (AO as grey, for viewers) only where the file has none.
+        if (!colors.values.empty() && !prim["attributes"].contains("COLOR_0"))
+            append(&colors, "COLOR_0");
     }
 
     if (!s.occlusion_image.empty()) {
