@@ -79,8 +79,7 @@ Timed subset_trace(const Mesh& mesh, const SphereRule& rule, VisibilityTracer& t
     tr.words_per_vertex = visit.words_per_vertex;
     tracer.set_mesh(mesh);
     tracer.set_rule(tr);
-    // Not for the directional method, which reads the offset directions of
-    // vertices first ... first + count: it is timed by whole bakes.
+    // (The directional method is timed by whole bakes: its cost is per chunk.)
     TraceChunk c;
     c.first = 0;
     c.count = count;

@@ -99,6 +99,8 @@ const NumericFlag kNumericFlags[] = {
     {{"mesh", "generate", "-o", "{out}/m.glb"}, "--seed", false, true},
     {{"ao", "{in}", "-o", "{out}/a.glb"}, "--max-distance", false, false},
     {{"ao", "{in}", "-o", "{out}/a.glb"}, "--offset", false, true},
+    {{"ao", "{in}", "-o", "{out}/a.glb", "--texture", "64"}, "--uv", false, true},
+    {{"ao", "{in}", "-o", "{out}/a.glb", "--texture", "64"}, "--dilate", false, true},
     {{"ao", "{in}", "-o", "{out}/a.glb", "--preview", "{out}/p.png"}, "--preview-azimuth", true, true},
     {{"ao", "{in}", "-o", "{out}/a.glb", "--preview", "{out}/p.png"}, "--preview-elevation", true, true},
     {{"sky", "optical-length", "--cos-zenith", "1"}, "--density", false, false},

@@ -1,12 +1,13 @@
-// skybake ao INPUT -o OUTPUT.glb|.ply [--rule R] [--device D] [--backend B] [--method M] [--resolution N]
+// skybake ao INPUT -o OUTPUT.glb|.gltf|.ply [--rule R] [--device D] [--backend B] [--method M] [--resolution N]
 //            [--max-distance D] [--offset E]
 //            [--back-faces occlude|ignore] [--normalize] [--bits FILE] [--preview FILE.png]
-//            [--preview-size WxH] [--json]
+//            [--preview-size WxH] [--texture N [--uv K] [--texture-out FILE.png|.exr] [--dilate N]] [--json]
 #include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <optional>
 
 #include "cli.h"
 #include "commands.h"
@@ -14,8 +15,10 @@
 #include "skybake/files.h"
 #include "skybake/bake.h"
 #include "skybake/core.h"
+#include "skybake/gltf_asset.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
+#include "skybake/texture_bake.h"
 #include "skybake/visibility.h"
 
 namespace skybake::cli {
@@ -40,7 +43,42 @@ struct AoOptions {
     std::string preview_size = "960x720";
     float azimuth_deg = 35.0f, elevation_deg = 30.0f;
     bool json = false;
+    int texture = 0; // texture size; 0: no texture bake
+    int uv = 0;
+    std::string texture_out;
+    int dilate = 8;
 };
+
+// The texture file beside the output: OUT.glb -> OUT_ao.png.
+std::string default_texture_path(const std::string& output) {
+    std::filesystem::path p(output);
+    return (p.parent_path() / (p.stem().string() + "_ao.png")).string();
+}
+
+// Wires `image` as the occlusion texture of a plain mesh's materials, giving
+// the parts without one (or the whole mesh) a material of their own.
+void wire_occlusion(Mesh& mesh, const std::string& image, int uv_set) {
+    int bare = -1;
+    auto bare_material = [&] {
+        if (bare < 0) {
+            mesh.materials.push_back({});
+            mesh.materials.back().name = "skybake occlusion";
+            bare = int(mesh.materials.size() - 1);
+        }
+        return bare;
+    };
+    if (mesh.triangle_parts.empty()) {
+        mesh.parts.assign(1, MeshPart{});
+        mesh.triangle_parts.assign(mesh.triangle_count(), 0);
+    }
+    for (auto& part : mesh.parts)
+        if (part.material < 0)
+            part.material = bare_material();
+    for (auto& m : mesh.materials) {
+        m.occlusion_texture = image;
+        m.occlusion_texcoord = uv_set;
+    }
+}
 
 nlohmann::json stats(const std::vector<float>& v) {
     if (v.empty())
@@ -108,11 +146,21 @@ void run(const AoOptions& o, const CLI::App& sub) {
             refuse_if_given(sub, f, "without --preview");
     preview.azimuth_deg = o.azimuth_deg;
     preview.elevation_deg = o.elevation_deg;
-    check_output_path(o.output, {".glb", ".ply"}, "--output");
+    check_output_path(o.output, {".glb", ".gltf", ".ply"}, "--output");
     if (!o.preview.empty())
         check_output_path(o.preview, {".png", ".exr"}, "--preview");
     if (!o.bits.empty())
         check_output_path(o.bits, {}, "--bits");
+    const std::string texture_out = o.texture_out.empty() ? default_texture_path(o.output) : o.texture_out;
+    if (o.texture == 0) {
+        for (const char* f : {"--uv", "--texture-out", "--dilate"})
+            refuse_if_given(sub, f, "without --texture");
+    } else {
+        check_output_path(texture_out, {".png", ".exr"}, "--texture-out");
+        if (lower_extension(o.output) == ".ply")
+            throw UsageError("a texture bake is wired into a glTF material; write the mesh as .glb or .gltf",
+                             "--output");
+    }
     const auto tracer = make_visibility_tracer(backend_id, method, o.resolution); // no GPU or GL: exit 1
     const std::uint32_t resolution = o.resolution                  ? o.resolution
                                      : method == TraceMethod::Cube ? kRasterCubeResolution
@@ -126,18 +174,75 @@ void run(const AoOptions& o, const CLI::App& sub) {
     b.store_bits = !o.bits.empty();
     b.method = method;
 
-    Mesh mesh = load_mesh(o.input);
+    // A glTF 2.0 input written as glTF is baked in place: the output is the
+    // input document with the new attributes (skybake/gltf_asset.h).
+    const bool gltf_out = lower_extension(o.output) != ".ply";
+    std::optional<GltfAsset> asset;
+    if (gltf_out && GltfAsset::is_gltf2(o.input))
+        asset = GltfAsset::load(o.input);
+    else if (lower_extension(o.output) == ".gltf")
+        throw UsageError("a .gltf output keeps a glTF 2.0 input's document; write other inputs as .glb", "--output");
+    Mesh plain = asset ? Mesh() : load_mesh(o.input);
+    Mesh& mesh = asset ? asset->mesh() : plain;
+    // The texture bake first: its checks of the UV layout and the size come
+    // before any long work.
+    std::optional<AoTexture> texture;
+    TextureBakeOptions tb;
+    if (o.texture != 0) {
+        tb.texture_size = o.texture;
+        tb.uv_set = o.uv;
+        tb.dilate_texels = o.dilate;
+        if (mesh.normals.empty())
+            compute_normals(mesh);
+        texture = bake_ao_texture(mesh, rule, *tracer, b, tb);
+        if (texture->overlapping_texels > 0)
+            info("warning: UV set {} overlaps: {} texel centres lie in two or more triangles ({} triangles); "
+                 "the nearest triangle in mesh order wins there",
+                 o.uv, texture->overlapping_texels, texture->overlapping_triangles);
+    }
     BakeOutputs outputs;
     const AoBakeReport r = bake_ambient_occlusion(mesh, rule, *tracer, b, &outputs);
+    if (texture) {
+        if (asset)
+            asset->set_occlusion_texture(texture_out, o.uv);
+        else
+            wire_occlusion(mesh, std::filesystem::absolute(texture_out).string(), o.uv);
+    }
 
     // Every output is staged, then all are committed together: a failure in
     // any one of them leaves none written.
     OutputSet files;
-    save_mesh(files.stage(o.output), mesh);
-    if (!o.preview.empty())
+    if (asset)
+        asset->save(files.stage(o.output));
+    else
+        save_mesh(files.stage(o.output), mesh);
+    if (!o.preview.empty() && texture) {
+        // The texture on the model, over its base colour images where they load.
+        std::vector<Image> base_colors(mesh.materials.size());
+        for (std::size_t m = 0; m < mesh.materials.size(); ++m) {
+            std::error_code ec;
+            const std::string& image = mesh.materials[m].base_color_texture;
+            if (!image.empty() && std::filesystem::is_regular_file(image, ec))
+                base_colors[m] = load_image(image);
+        }
+        save_image(files.stage(o.preview), render_texture_preview(mesh, *texture, o.uv, base_colors, preview),
+                   ToneMap{0.0f, ToneCurve::Clamp});
+    } else if (!o.preview.empty()) {
         save_image(files.stage(o.preview), render_ao_preview(mesh, preview), ToneMap{0.0f, ToneCurve::Clamp});
+    }
     if (!o.bits.empty())
         save_visibility_bits(files.stage(o.bits), outputs, rule);
+    if (texture) {
+        const int n = texture->texture_size;
+        if (lower_extension(texture_out) == ".exr") {
+            Image image(n, n);
+            for (std::size_t k = 0; k < texture->ao.size(); ++k)
+                image.rgb[3 * k] = image.rgb[3 * k + 1] = image.rgb[3 * k + 2] = texture->ao[k];
+            save_exr(files.stage(texture_out), image);
+        } else {
+            save_png16_gray(files.stage(texture_out), n, n, texture->ao);
+        }
+    }
     files.commit();
 
     const std::string device = tracer->device_name();
@@ -170,6 +275,24 @@ void run(const AoOptions& o, const CLI::App& sub) {
                             {"preview", o.preview.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.preview)},
                             {"bits", o.bits.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.bits)},
                             {"threads", thread_count()}};
+        j["vertices_per_second"] = r.trace_seconds > 0 ? double(r.vertices) / r.trace_seconds : 0.0;
+        if (texture) {
+            const double sec = texture->trace_seconds;
+            j["texture"] = {{"file", texture_out},
+                            {"size", texture->texture_size},
+                            {"uv_set", o.uv},
+                            {"covered_texels", texture->covered_texels},
+                            {"overlapping_texels", texture->overlapping_texels},
+                            {"overlapping_triangles", texture->overlapping_triangles},
+                            {"dilate_texels", o.dilate},
+                            {"rays", texture->rays},
+                            {"sample_seconds", texture->sample_seconds},
+                            {"build_seconds", texture->build_seconds},
+                            {"trace_seconds", sec},
+                            {"texels_per_second", sec > 0 ? double(texture->covered_texels) / sec : 0.0}};
+        } else {
+            j["texture"] = nullptr;
+        }
         print_json(j);
         return;
     }
@@ -188,8 +311,14 @@ void run(const AoOptions& o, const CLI::App& sub) {
     if (r.negative_weights)
         info("note: {} has negative weights; {} vertices had sums outside [0, 1], clamped", r.rule,
              r.clamped_vertices);
-    info("mean AO {:.4f}, ray offset {:.3g}; wrote {}{}{}", mean, r.ray_offset, o.output,
-         o.preview.empty() ? "" : ", " + o.preview, o.bits.empty() ? "" : ", " + o.bits);
+    if (texture)
+        info("texture {}x{}: {} texels covered, {} rays in {:.2f} s ({:.0f} texels/s; vertices {:.0f}/s)",
+             texture->texture_size, texture->texture_size, texture->covered_texels, texture->rays,
+             texture->trace_seconds, double(texture->covered_texels) / std::max(1e-9, texture->trace_seconds),
+             double(r.vertices) / std::max(1e-9, r.trace_seconds));
+    info("mean AO {:.4f}, ray offset {:.3g}; wrote {}{}{}{}", mean, r.ray_offset, o.output,
+         o.preview.empty() ? "" : ", " + o.preview, o.bits.empty() ? "" : ", " + o.bits,
+         texture ? ", " + texture_out : "");
 }
 
 } // namespace
@@ -198,7 +327,8 @@ void add_ao_bake(CLI::App& group) {
     auto o = std::make_shared<AoOptions>();
     CLI::App* sub = &group;
     sub->add_option("input", o->input, "Input mesh (any format 'mesh info' reads)")->required();
-    sub->add_option("-o,--output", o->output, "Output mesh with AO, shading and bent normals (.glb or .ply)")
+    sub->add_option("-o,--output", o->output, "Output mesh with AO, shading and bent normals (.glb, .gltf or .ply); a glTF 2.0 input keeps its "
+                    "whole document (nodes, materials, UVs, animations...)")
         ->required();
     sub->add_option("--rule", o->rule,
                     "Sphere rule, e.g. lebedev:5810, design:t21, fibonacci:1000, mc:4096; add +rotate for a random "
@@ -237,6 +367,17 @@ void add_ao_bake(CLI::App& group) {
         ->capture_default_str();
     sub->add_option("--preview-elevation", o->elevation_deg, "Preview camera elevation, degrees")
         ->check(real_in(-90.0, 90.0, "degrees"))
+        ->capture_default_str();
+    sub->add_option("--texture", o->texture,
+                    "Also bake AO into a texture of this many texels square over the mesh's UVs (16 to 16384), "
+                    "wired as the glTF material's occlusionTexture");
+    sub->add_option("--uv", o->uv, "UV set (TEXCOORD_n) of the texture bake")
+        ->check(integer_in(0, 7))
+        ->capture_default_str();
+    sub->add_option("--texture-out", o->texture_out,
+                    "The AO texture file: .png (16-bit grey) or .exr (default: OUTPUT's name + _ao.png)");
+    sub->add_option("--dilate", o->dilate, "Gutter grown around the UV islands of the texture, texels")
+        ->check(integer_in(0, 256, "texels"))
         ->capture_default_str();
     add_json_flag(*sub, o->json);
     sub->callback([o, sub] { run(*o, *sub); });

@@ -189,6 +189,9 @@ std::string flag_for_field(const std::string& where) {
         {"model", "--model"},
         {"albedo", "--albedo"},
         {"light", "--light"},
+        {"texture_size", "--texture"},
+        {"uv_set", "--uv"},
+        {"dilate_texels", "--dilate"},
     };
     for (const auto& [field, flag] : kFields)
         if (where == field)

@@ -1,7 +1,8 @@
-// skybake mesh convert INPUT -o OUTPUT.glb|.ply [--ascii] [--json]
+// skybake mesh convert INPUT -o OUTPUT.glb|.gltf|.ply [--ascii] [--json]
 #include "cli.h"
 #include "commands.h"
 #include "flags.h"
+#include "skybake/gltf_asset.h"
 #include "skybake/mesh.h"
 
 namespace skybake::cli {
@@ -14,14 +15,26 @@ struct MeshConvertOptions {
 };
 
 void run(const MeshConvertOptions& o) {
-    check_output_path(o.output, {".glb", ".ply"}, "--output");
+    check_output_path(o.output, {".glb", ".gltf", ".ply"}, "--output");
     if (o.ascii && lower_extension(o.output) != ".ply")
         throw UsageError("--ascii applies to .ply outputs only", "--ascii");
     ImportReport rep;
-    const Mesh mesh = load_mesh(o.input, &rep);
-    ExportOptions e;
-    e.ply_encoding = o.ascii ? PlyEncoding::Ascii : PlyEncoding::Binary;
-    save_mesh(o.output, mesh, e);
+    Mesh mesh;
+    if (lower_extension(o.output) != ".ply" && GltfAsset::is_gltf2(o.input)) {
+        // glTF 2.0 to glTF: the document is kept whole (skybake/gltf_asset.h).
+        const GltfAsset asset = GltfAsset::load(o.input);
+        asset.save(o.output);
+        mesh = asset.mesh();
+        rep = asset.report();
+    } else {
+        if (lower_extension(o.output) == ".gltf")
+            throw UsageError("a .gltf output keeps a glTF 2.0 input's document; write other inputs as .glb",
+                             "--output");
+        mesh = load_mesh(o.input, &rep);
+        ExportOptions e;
+        e.ply_encoding = o.ascii ? PlyEncoding::Ascii : PlyEncoding::Binary;
+        save_mesh(o.output, mesh, e);
+    }
     if (o.json) {
         print_json({{"input", o.input},
                     {"output", o.output},
@@ -38,7 +51,7 @@ void add_mesh_convert(CLI::App& group) {
     auto o = std::make_shared<MeshConvertOptions>();
     CLI::App* sub = group.add_subcommand("convert", "Read any supported mesh and write it as .glb or .ply");
     sub->add_option("input", o->input, "Input mesh")->required();
-    sub->add_option("-o,--output", o->output, "Output mesh (.glb or .ply)")->required();
+    sub->add_option("-o,--output", o->output, "Output mesh (.glb, .gltf or .ply); a glTF 2.0 input written as glTF keeps its whole document")->required();
     sub->add_flag("--ascii", o->ascii, "Write PLY as ASCII instead of binary");
     add_json_flag(*sub, o->json);
     sub->callback([o] { run(*o); });

@@ -180,6 +180,25 @@ struct VisibilityBakeStats {
 VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, VisibilityTracer& tracer,
                                     const BakeOptions& options, VisibilityReduction& reduction);
 
+// Sample points other than the mesh's vertices (texel centres of a texture
+// bake, skybake/texture_bake.h): the bake measures visibility at points on
+// the mesh's surface, of which its vertices are one kind. Point i's ray
+// origin is positions[i] + (offset + ε)·normals[i], with ε the rounding step
+// of [SECTION] Bake options for a triangle of size sizes[i]; reductions see
+// point i where they would see vertex i.
+struct SamplePoints {
+    std::vector<glm::vec3> positions; // world space, on the mesh's surface
+    std::vector<glm::vec3> normals;   // unit, world space; as many as positions
+    std::vector<float> sizes;         // each point's footprint (e.g. a texel), mesh units; as many
+};
+
+// Same as bake_visibility() above, at `points` instead of the vertices: the
+// mesh is the geometry that occludes. Also throws for arrays of different
+// sizes ("points").
+VisibilityBakeStats bake_visibility(const Mesh& mesh, const SamplePoints& points, const SphereRule& rule,
+                                    VisibilityTracer& tracer, const BakeOptions& options,
+                                    VisibilityReduction& reduction);
+
 // The reduction behind bake_ambient_occlusion(): AO, A and the bent normal of
 // every vertex into `out` (and the words, with options.store_bits).
 class ShadingReduction final : public VisibilityReduction {

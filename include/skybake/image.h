@@ -69,6 +69,11 @@ void save_png(const std::filesystem::path& path, const Image& image, const ToneM
 // Writes an 8-bit sRGB buffer (3 bytes per pixel) as PNG.
 void save_png_srgb8(const std::filesystem::path& path, int width, int height, const std::uint8_t* rgb);
 
+// Writes one channel of linear values in [0, 1] (clamped; width * height,
+// row-major, top row first) as a 16-bit greyscale PNG, without the sRGB
+// curve: data such as an occlusion texture, which glTF reads linearly.
+void save_png16_gray(const std::filesystem::path& path, int width, int height, const std::vector<float>& values);
+
 // Reads an EXR or a Radiance .hdr (linear) or a PNG/JPEG (sRGB, decoded to linear).
 // Throws skybake::Error on a missing or corrupt file.
 Image load_image(const std::filesystem::path& path);

@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
@@ -34,12 +35,42 @@ struct VertexAttribute {
     std::vector<float> values; // vertex_count * components
 };
 
+// A material as far as a Mesh carries it (glTF pbrMetallicRoughness).
+struct MeshMaterial {
+    std::string name;
+    glm::vec4 base_color{1.0f}; // linear RGBA factor
+    // The base colour image: a path, relative to the current folder or
+    // absolute, as resolved against the source file's folder; empty if none
+    // (or embedded in the source, which is not carried).
+    std::string base_color_texture;
+    int base_color_texcoord = 0; // the UV set (Mesh::texcoords) the image is mapped with
+    // An ambient occlusion image (glTF occlusionTexture, read from its red
+    // channel), a path as base_color_texture; empty if none.
+    std::string occlusion_texture;
+    int occlusion_texcoord = 0;
+};
+
+// The triangles that came from one node (or mesh) of the source scene.
+struct MeshPart {
+    std::string name;  // the node's name; may be empty
+    int material = -1; // index into Mesh::materials, or -1: none
+};
+
 struct Mesh {
     std::vector<glm::vec3> positions;  // world space, file units
     std::vector<glm::vec3> normals;    // unit length; empty until computed
     std::vector<glm::vec4> colors;     // linear RGBA in [0, 1]; may be empty
     std::vector<std::uint32_t> indices; // 3 per triangle, counter-clockwise front faces
     std::vector<VertexAttribute> attributes;
+    // UV sets, TEXCOORD_0, TEXCOORD_1, ...: each one has vertex_count()
+    // entries. glTF's convention: (0, 0) is the image's top-left corner and v
+    // grows downwards (readers of other conventions flip v).
+    std::vector<std::vector<glm::vec2>> texcoords;
+    std::vector<MeshMaterial> materials;
+    std::vector<MeshPart> parts;
+    // Empty (the whole mesh is one unnamed part without a material), or one
+    // entry per triangle: its index into parts.
+    std::vector<std::uint32_t> triangle_parts;
 
     std::size_t vertex_count() const { return positions.size(); }
     std::size_t triangle_count() const { return indices.size() / 3; }
@@ -110,7 +141,9 @@ struct ExportOptions {
 };
 
 // Writes by extension: ".glb" (glTF 2.0 binary: POSITION, NORMAL, COLOR_0,
-// and every attribute as "_NAME", float) or ".ply" (x y z nx ny nz, colours as
+// TEXCOORD_n, every attribute as "_NAME", float; one node and mesh per part,
+// named after it, with its material, whose image is referenced by a URI
+// relative to the output's folder) or ".ply" (x y z nx ny nz, colours as
 // uchar red green blue alpha, attributes as float properties). The file is
 // written to a temporary file beside the target and renamed when complete.
 // Throws skybake::Error on an unknown extension, an invalid mesh or I/O failure.

@@ -158,6 +158,10 @@ struct TraceChunk {
     std::uint32_t count = 0;
     std::span<const glm::vec3> origins;     // ray origins, mesh units
     std::span<const glm::vec3> normals;     // unit: the horizon of each vertex
+    // Unit: the direction in which the driver moved each origin off its point
+    // (the normal, or on borders and creases the normal plus a tangent towards
+    // the vertex's triangles, normalised). May be empty: then the normals.
+    std::span<const glm::vec3> offsets;
     std::span<const glm::mat3> rotations;   // direction k of vertex v is rotations[v]·x_k
     // Output, in the layout of [SECTION] Visibility words: trace() writes every
     // word. May be empty for a tracer with device_words_supported(): the

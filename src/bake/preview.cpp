@@ -11,6 +11,7 @@
 #include "bake/preview.h"
 #include "skybake/bake.h"
 #include "skybake/error.h"
+#include "skybake/texture_bake.h"
 
 namespace skybake {
 
@@ -108,6 +109,38 @@ Image render_vertex_preview(const Mesh& mesh, std::span<const glm::vec3> linear_
         throw Error(fmt::format("{} vertex colours for {} vertices", linear_rgb.size(), mesh.vertex_count()), "mesh");
     return bake::render_preview(mesh, o, [&](const std::uint32_t* tri, float u, float v, const glm::vec3&) {
         return (1.0f - u - v) * linear_rgb[tri[0]] + u * linear_rgb[tri[1]] + v * linear_rgb[tri[2]];
+    });
+}
+
+Image render_texture_preview(const Mesh& mesh, const AoTexture& texture, int uv_set,
+                             const std::vector<Image>& base_colors, const AoPreviewOptions& o) {
+    validate_mesh(mesh, "mesh");
+    if (uv_set < 0 || std::size_t(uv_set) >= mesh.texcoords.size())
+        throw Error(fmt::format("the mesh has no UV set {} to read the texture with", uv_set), "uv_set");
+    if (texture.ao.size() != std::size_t(texture.texture_size) * std::size_t(texture.texture_size))
+        throw Error("the AO texture is empty; bake it first", "texture");
+    const std::vector<glm::vec2>& uvs = mesh.texcoords[std::size_t(uv_set)];
+    return bake::render_preview(mesh, o, [&](const std::uint32_t* tri, float u, float v, const glm::vec3&) {
+        const auto triangle = std::size_t(tri - mesh.indices.data()) / 3;
+        const glm::vec2 uv = (1.0f - u - v) * uvs[tri[0]] + u * uvs[tri[1]] + v * uvs[tri[2]];
+        glm::vec3 albedo(0.8f);
+        if (!mesh.triangle_parts.empty()) {
+            const int m = mesh.parts[mesh.triangle_parts[triangle]].material;
+            if (m >= 0) {
+                const MeshMaterial& mat = mesh.materials[std::size_t(m)];
+                albedo = glm::vec3(mat.base_color);
+                if (std::size_t(m) < base_colors.size() && base_colors[std::size_t(m)].width > 0) {
+                    // Nearest texel of the base colour image (its own UV set is assumed to be uv_set's).
+                    const Image& img = base_colors[std::size_t(m)];
+                    const float fu = uv.x - std::floor(uv.x), fv = uv.y - std::floor(uv.y);
+                    const int x = std::clamp(int(fu * float(img.width)), 0, img.width - 1);
+                    const int y = std::clamp(int(fv * float(img.height)), 0, img.height - 1);
+                    const float* p = img.pixel(x, y);
+                    albedo *= glm::vec3(p[0], p[1], p[2]);
+                }
+            }
+        }
+        return albedo * std::clamp(sample_texture(texture, uv), 0.0f, 1.0f);
     });
 }
 

@@ -62,21 +62,20 @@ float resolve_ray_offset(const Mesh&, const BakeOptions& options) {
     return options.ray_offset > 0.0f ? options.ray_offset : 0.0f;
 }
 
-VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, VisibilityTracer& tracer,
-                                    const BakeOptions& options, VisibilityReduction& reduction) {
-    check_inputs(mesh, rule, options);
-    if (options.method != tracer.method())
-        throw Error(fmt::format("the {} method is not the {} tracer's (it has {}); create the tracer with the method",
-                                trace_method_name(options.method), tracer.name(), trace_method_name(tracer.method())),
-                    "method");
-    const auto n = std::uint32_t(mesh.vertex_count());
+namespace {
 
+// The loop itself, over n sample points whose ray frame frame(i, origin,
+// normal, offset direction) gives: the mesh's vertices, or other points on
+// its surface.
+template <class Frame>
+VisibilityBakeStats bake_points(const Mesh& mesh, std::uint32_t n, float ray_offset, const Frame& frame,
+                                const SphereRule& rule, VisibilityTracer& tracer, const BakeOptions& options,
+                                VisibilityReduction& reduction) {
     const bake::VisitingRule visit = bake::visiting_rule(rule);
     const std::uint32_t words = visit.words_per_vertex;
     const bool rotate = visit.rotate;
     VisibilityBakeStats stats;
-    const bake::VertexRays rays = bake::vertex_rays(mesh, options);
-    stats.ray_offset = rays.offset;
+    stats.ray_offset = ray_offset;
 
     const auto t0 = std::chrono::steady_clock::now();
     tracer.set_mesh(mesh, options.back_faces);
@@ -101,7 +100,7 @@ VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, Vi
 
     const bool host_words = !(tracer.device_words_supported() && reduction.reduces_on_device());
     const std::uint64_t per_vertex =
-        2 * sizeof(glm::vec3) + (rotate ? sizeof(glm::mat3) : 0) + (host_words ? 4ull * words : 0);
+        3 * sizeof(glm::vec3) + (rotate ? sizeof(glm::mat3) : 0) + (host_words ? 4ull * words : 0);
     const auto memory_limit = std::uint32_t(std::clamp<std::uint64_t>(kChunkBytes / per_vertex, 1, 0xffffffffu));
     // A GPU or raster tracer takes the largest chunk it allows (fewer launches,
     // fewer depth maps); a CPU tracer's chunks are sized for the progress bar
@@ -111,7 +110,7 @@ VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, Vi
     const std::uint32_t chunk =
         std::max<std::uint32_t>(1, std::min({wanted, tracer_limit, memory_limit, std::max(n, 1u)}));
 
-    std::vector<glm::vec3> origins(chunk), chunk_normals(chunk);
+    std::vector<glm::vec3> origins(chunk), chunk_normals(chunk), offsets(chunk);
     std::vector<glm::mat3> rotations(rotate ? chunk : 0);
     std::vector<std::uint32_t> chunk_words(host_words ? std::size_t(chunk) * words : 0);
     Progress progress("bake", n);
@@ -120,8 +119,7 @@ VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, Vi
         parallel_for(count, 1024, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) {
                 const std::size_t v = first + i;
-                chunk_normals[i] = rays.normals[v];
-                origins[i] = rays.origin(mesh, v);
+                frame(v, origins[i], chunk_normals[i], offsets[i]);
                 if (rotate)
                     rotations[i] = visit.rotation(std::uint32_t(v));
             }
@@ -131,6 +129,7 @@ VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, Vi
         tc.count = count;
         tc.origins = std::span<const glm::vec3>(origins.data(), count);
         tc.normals = std::span<const glm::vec3>(chunk_normals.data(), count);
+        tc.offsets = std::span<const glm::vec3>(offsets.data(), count);
         if (rotate)
             tc.rotations = std::span<const glm::mat3>(rotations.data(), count);
         if (host_words)
@@ -150,6 +149,51 @@ VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, Vi
     progress.finish();
     stats.trace_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     return stats;
+}
+
+void check_method(const BakeOptions& options, const VisibilityTracer& tracer) {
+    if (options.method != tracer.method())
+        throw Error(fmt::format("the {} method is not the {} tracer's (it has {}); create the tracer with the method",
+                                trace_method_name(options.method), tracer.name(), trace_method_name(tracer.method())),
+                    "method");
+}
+
+} // namespace
+
+VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, VisibilityTracer& tracer,
+                                    const BakeOptions& options, VisibilityReduction& reduction) {
+    check_inputs(mesh, rule, options);
+    check_method(options, tracer);
+    const bake::VertexRays rays = bake::vertex_rays(mesh, options);
+    const auto frame = [&](std::size_t v, glm::vec3& origin, glm::vec3& normal, glm::vec3& offset) {
+        normal = rays.normals[v];
+        origin = rays.origin(mesh, v);
+        offset = glm::normalize(rays.normals[v] + rays.inward[v]);
+    };
+    return bake_points(mesh, std::uint32_t(mesh.vertex_count()), rays.offset, frame, rule, tracer, options,
+                       reduction);
+}
+
+VisibilityBakeStats bake_visibility(const Mesh& mesh, const SamplePoints& points, const SphereRule& rule,
+                                    VisibilityTracer& tracer, const BakeOptions& options,
+                                    VisibilityReduction& reduction) {
+    check_inputs(mesh, rule, options);
+    check_method(options, tracer);
+    const std::size_t n = points.positions.size();
+    if (points.normals.size() != n || points.sizes.size() != n)
+        throw Error(fmt::format("{} sample positions, {} normals and {} sizes; they must be as many", n,
+                                points.normals.size(), points.sizes.size()),
+                    "points");
+    if (n >= std::size_t(0xffffffffu))
+        throw Error(fmt::format("{} sample points is too many; the bake handles up to 4,294,967,294", n), "points");
+    const float offset = resolve_ray_offset(mesh, options);
+    const auto frame = [&](std::size_t v, glm::vec3& origin, glm::vec3& normal, glm::vec3& offset_direction) {
+        normal = points.normals[v];
+        offset_direction = normal;
+        origin = bake::ray_origin(points.positions[v], normal, glm::vec3(0.0f), offset,
+                                  bake::rounding_step(points.positions[v], points.sizes[v]));
+    };
+    return bake_points(mesh, std::uint32_t(n), offset, frame, rule, tracer, options, reduction);
 }
 
 namespace bake {

@@ -102,6 +102,22 @@ std::string serialise(const RawImport& r) {
         w.pod(std::int32_t(a.components));
         w.vec(a.values);
     }
+    w.pod(std::uint64_t(r.mesh.texcoords.size()));
+    for (const auto& uv : r.mesh.texcoords)
+        w.vec(uv);
+    w.pod(std::uint64_t(r.mesh.materials.size()));
+    for (const auto& m : r.mesh.materials) {
+        w.str(m.name);
+        w.pod(m.base_color);
+        w.str(m.base_color_texture);
+        w.pod(std::int32_t(m.base_color_texcoord));
+    }
+    w.pod(std::uint64_t(r.mesh.parts.size()));
+    for (const auto& p : r.mesh.parts) {
+        w.str(p.name);
+        w.pod(std::int32_t(p.material));
+    }
+    w.vec(r.mesh.triangle_parts);
     w.str(r.report.format);
     w.pod(std::uint64_t(r.report.source_meshes));
     w.pod(std::uint64_t(r.report.degenerate_triangles));
@@ -131,6 +147,32 @@ RawImport deserialise(const std::string& buf, const std::string& where) {
         a.values = rd.vec<float>();
         r.mesh.attributes.push_back(std::move(a));
     }
+    const auto uv_sets = rd.pod<std::uint64_t>();
+    if (uv_sets > 64)
+        throw Error("the isolated importer sent an unreadable result", where);
+    for (std::uint64_t i = 0; i < uv_sets; ++i)
+        r.mesh.texcoords.push_back(rd.vec<glm::vec2>());
+    const auto materials = rd.pod<std::uint64_t>();
+    if (materials > (std::uint64_t(1) << 20))
+        throw Error("the isolated importer sent an unreadable result", where);
+    for (std::uint64_t i = 0; i < materials; ++i) {
+        MeshMaterial m;
+        m.name = rd.str();
+        m.base_color = rd.pod<glm::vec4>();
+        m.base_color_texture = rd.str();
+        m.base_color_texcoord = rd.pod<std::int32_t>();
+        r.mesh.materials.push_back(std::move(m));
+    }
+    const auto parts = rd.pod<std::uint64_t>();
+    if (parts > (std::uint64_t(1) << 24))
+        throw Error("the isolated importer sent an unreadable result", where);
+    for (std::uint64_t i = 0; i < parts; ++i) {
+        MeshPart p;
+        p.name = rd.str();
+        p.material = rd.pod<std::int32_t>();
+        r.mesh.parts.push_back(std::move(p));
+    }
+    r.mesh.triangle_parts = rd.vec<std::uint32_t>();
     r.report.format = rd.str();
     r.report.source_meshes = rd.pod<std::uint64_t>();
     r.report.degenerate_triangles = rd.pod<std::uint64_t>();

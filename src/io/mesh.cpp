@@ -82,6 +82,20 @@ void validate_mesh(const Mesh& mesh, const std::string& where) {
             throw Error(fmt::format("attribute '{}' has {} values for {} vertices x {} components", a.name,
                                     a.values.size(), n, a.components),
                         where);
+    for (std::size_t k = 0; k < mesh.texcoords.size(); ++k)
+        if (mesh.texcoords[k].size() != n)
+            throw Error(fmt::format("UV set {} has {} entries for {} vertices", k, mesh.texcoords[k].size(), n), where);
+    if (!mesh.triangle_parts.empty() && mesh.triangle_parts.size() != mesh.indices.size() / 3)
+        throw Error(fmt::format("{} triangle parts for {} triangles", mesh.triangle_parts.size(), mesh.indices.size() / 3),
+                    where);
+    for (std::uint32_t p : mesh.triangle_parts)
+        if (p >= mesh.parts.size())
+            throw Error(fmt::format("a triangle belongs to part {}, but the mesh has {}", p, mesh.parts.size()), where);
+    for (const auto& part : mesh.parts)
+        if (part.material < -1 || part.material >= int(mesh.materials.size()))
+            throw Error(fmt::format("part '{}' uses material {}, but the mesh has {}", part.name, part.material,
+                                    mesh.materials.size()),
+                        where);
     for (std::size_t v = 0; v < n; ++v) {
         const auto& p = mesh.positions[v];
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
@@ -133,11 +147,15 @@ Mesh finish_import(RawImport raw, const std::string& where, const ImportLimits& 
             ++rep.degenerate_triangles;
             continue;
         }
+        if (!mesh.triangle_parts.empty())
+            mesh.triangle_parts[kept / 3] = mesh.triangle_parts[t / 3];
         mesh.indices[kept++] = a;
         mesh.indices[kept++] = b;
         mesh.indices[kept++] = c;
     }
     mesh.indices.resize(kept);
+    if (!mesh.triangle_parts.empty())
+        mesh.triangle_parts.resize(kept / 3);
     if (mesh.indices.empty())
         throw Error(fmt::format("all {} triangles are degenerate (zero area)", rep.degenerate_triangles), where);
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <map>
 
 #include <fmt/format.h>
 #include <glm/gtc/matrix_inverse.hpp>
@@ -33,6 +34,7 @@ namespace skybake::io {
 namespace {
 
 constexpr unsigned kMaxNodeDepth = 256;
+constexpr std::size_t kMaxUvSets = 8;
 
 struct FsContext {
     std::string base_dir; // empty: no external files (loading from memory)
@@ -80,6 +82,21 @@ bool fs_write(std::string* err, const std::string&, const std::vector<unsigned c
 // Images are not needed for lighting; skip decoding them.
 bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
     return true;
+}
+
+// "My%20File.png" -> "My File.png" (RFC 3986 percent-encoding).
+std::string percent_decode(const std::string& uri) {
+    std::string out;
+    for (std::size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
+            std::isxdigit(static_cast<unsigned char>(uri[i + 2]))) {
+            out += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+            i += 2;
+        } else {
+            out += uri[i];
+        }
+    }
+    return out;
 }
 
 struct AccessorView {
@@ -234,15 +251,18 @@ public:
             if (std::size_t(node.mesh) >= model_.meshes.size())
                 fail(fmt::format("node {} refers to mesh {}, but there are {}", node_index, node.mesh,
                                  model_.meshes.size()));
-            append_mesh(model_.meshes[std::size_t(node.mesh)], world);
+            append_mesh(model_.meshes[std::size_t(node.mesh)], world, node_index, node.mesh);
         }
         for (int child : node.children)
             visit(child, world, depth + 1);
     }
 
-    void append_mesh(const tinygltf::Mesh& m, const glm::dmat4& world) {
+    void append_mesh(const tinygltf::Mesh& m, const glm::dmat4& world, int node_index, int mesh_index) {
         const glm::dmat3 normal_matrix = glm::inverseTranspose(glm::dmat3(world));
-        for (const tinygltf::Primitive& prim : m.primitives) {
+        // A mirroring transform turns the winding over (glTF 2.0, section 3.7.4).
+        const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+        for (std::size_t prim_index = 0; prim_index < m.primitives.size(); ++prim_index) {
+            const tinygltf::Primitive& prim = m.primitives[prim_index];
             if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != -1) {
                 ++out.report.non_triangles;
                 continue;
@@ -257,6 +277,8 @@ public:
             const std::size_t base = mesh.positions.size();
             check_counts(base + pos.count, mesh.triangle_count(), limits_, where_);
             ++out.report.source_meshes;
+            instances.push_back({node_index, mesh_index, int(prim_index), base, pos.count, glm::dmat3(world)});
+            const std::size_t first_index = mesh.indices.size();
 
             for (std::size_t i = 0; i < pos.count; ++i) {
                 const glm::dvec4 p = world * glm::dvec4(read(pos, i, 0), read(pos, i, 1), read(pos, i, 2), 1.0);
@@ -288,6 +310,28 @@ public:
             } else {
                 mesh.colors.resize(mesh.positions.size(), glm::vec4(1.0f));
             }
+            // UV sets
+            for (std::size_t k = 0; k < kMaxUvSets; ++k) {
+                auto uv_it = prim.attributes.find("TEXCOORD_" + std::to_string(k));
+                if (uv_it == prim.attributes.end())
+                    break;
+                const AccessorView uv = view(uv_it->second, "TEXCOORD");
+                if (uv.count != pos.count || uv.components != 2)
+                    fail(fmt::format("TEXCOORD_{} must be a VEC2 accessor with one entry per vertex", k));
+                if (mesh.texcoords.size() <= k)
+                    mesh.texcoords.resize(k + 1);
+                mesh.texcoords[k].resize(base, glm::vec2(0.0f));
+                for (std::size_t i = 0; i < uv.count; ++i)
+                    mesh.texcoords[k].emplace_back(read(uv, i, 0), read(uv, i, 1));
+            }
+            for (auto& uv : mesh.texcoords)
+                uv.resize(mesh.positions.size(), glm::vec2(0.0f));
+            // The node's part, with the primitive's material.
+            const int material = prim.material >= 0 && std::size_t(prim.material) < model_.materials.size()
+                                     ? material_index(prim.material)
+                                     : -1;
+            mesh.parts.push_back({model_.nodes[std::size_t(node_index)].name, material});
+            part_of_primitive = std::uint32_t(mesh.parts.size() - 1);
             // Application-specific attributes: "_AO" -> "ao"
             for (const auto& [semantic, acc] : prim.attributes) {
                 if (semantic.size() < 2 || semantic[0] != '_')
@@ -339,14 +383,49 @@ public:
                 for (std::size_t i = 0; i < pos.count; ++i)
                     mesh.indices.push_back(std::uint32_t(base + i));
             }
+            if (mirrored)
+                for (std::size_t t = first_index; t + 2 < mesh.indices.size(); t += 3)
+                    std::swap(mesh.indices[t + 1], mesh.indices[t + 2]);
+            mesh.triangle_parts.resize(mesh.indices.size() / 3, part_of_primitive);
         }
     }
 
+    // The Mesh material for glTF material `m`, added on first use.
+    int material_index(int m) {
+        if (auto it = materials_.find(m); it != materials_.end())
+            return it->second;
+        const tinygltf::Material& gm = model_.materials[std::size_t(m)];
+        MeshMaterial mm;
+        mm.name = gm.name;
+        const auto& f = gm.pbrMetallicRoughness.baseColorFactor;
+        if (f.size() == 4)
+            mm.base_color = glm::vec4(float(f[0]), float(f[1]), float(f[2]), float(f[3]));
+        const int t = gm.pbrMetallicRoughness.baseColorTexture.index;
+        if (t >= 0 && std::size_t(t) < model_.textures.size()) {
+            const int i = model_.textures[std::size_t(t)].source;
+            if (i >= 0 && std::size_t(i) < model_.images.size()) {
+                const std::string& uri = model_.images[std::size_t(i)].uri;
+                if (!uri.empty() && uri.rfind("data:", 0) != 0 && !base_dir_.empty()) {
+                    const std::string decoded = percent_decode(uri);
+                    mm.base_color_texture = (std::filesystem::path(base_dir_) / decoded).lexically_normal().string();
+                }
+            }
+            mm.base_color_texcoord = gm.pbrMetallicRoughness.baseColorTexture.texCoord;
+        }
+        out.mesh.materials.push_back(std::move(mm));
+        return materials_[m] = int(out.mesh.materials.size() - 1);
+    }
+
     RawImport out;
+    std::vector<GltfPrimitiveInstance> instances;
+    std::uint32_t part_of_primitive = 0;
     bool missing_normals = false;
     bool any_colors = false;
 
+    std::string base_dir_;
+
 private:
+    std::map<int, int> materials_;
     const tinygltf::Model& model_;
     const std::string& where_;
     const ImportLimits& limits_;
@@ -355,7 +434,7 @@ private:
 } // namespace
 
 RawImport read_gltf(const void* data, std::size_t size, bool binary, const std::string& base_dir,
-                    const std::string& where, const ImportLimits& limits) {
+                    const std::string& where, const ImportLimits& limits, GltfSceneMap* scene) {
     tinygltf::TinyGLTF loader;
     FsContext fs_ctx{base_dir, limits.max_file_bytes};
     loader.SetFsCallbacks({fs_exists, fs_expand, fs_read, fs_write, &fs_ctx});
@@ -381,6 +460,7 @@ RawImport read_gltf(const void* data, std::size_t size, bool binary, const std::
     }
 
     Reader reader(model, where, limits);
+    reader.base_dir_ = base_dir;
     reader.out.report.format = binary ? "glb" : "gltf";
     std::vector<int> roots;
     if (!model.scenes.empty()) {
@@ -405,6 +485,12 @@ RawImport read_gltf(const void* data, std::size_t size, bool binary, const std::
         reader.out.mesh.normals.clear();
     if (!reader.any_colors)
         reader.out.mesh.colors.clear();
+    if (scene) {
+        scene->instances = std::move(reader.instances);
+        scene->buffers.clear();
+        for (auto& b : model.buffers)
+            scene->buffers.push_back(std::move(b.data));
+    }
     return std::move(reader.out);
 }
 
@@ -449,55 +535,162 @@ int vec_type(int components) {
 
 } // namespace
 
+// A URI for `image` as seen from `folder`: relative when it can be, with
+// spaces percent-encoded.
+std::string image_uri(const std::string& image, const std::filesystem::path& folder) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    fs::path rel = fs::absolute(fs::path(image), ec).lexically_normal();
+    const fs::path base = fs::absolute(folder.empty() ? fs::path(".") : folder, ec).lexically_normal();
+    if (const fs::path r = rel.lexically_relative(base); !r.empty())
+        rel = r;
+    std::string uri;
+    for (char c : rel.generic_string())
+        uri += c == ' ' ? std::string("%20") : std::string(1, c);
+    return uri;
+}
+
 void write_glb(const std::filesystem::path& tmp, const Mesh& mesh) {
     tinygltf::Model model;
     model.asset.version = "2.0";
     model.asset.generator = "skybake";
     model.buffers.resize(1);
-    tinygltf::Primitive prim;
-    prim.mode = TINYGLTF_MODE_TRIANGLES;
-    const std::size_t n = mesh.vertex_count();
 
-    const int pv = add_view(model, mesh.positions.data(), n * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER);
-    const int pa = add_accessor(model, pv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n);
-    const Bounds b = compute_bounds(mesh); // POSITION requires min and max
-    model.accessors[std::size_t(pa)].minValues = {b.min.x, b.min.y, b.min.z};
-    model.accessors[std::size_t(pa)].maxValues = {b.max.x, b.max.y, b.max.z};
-    prim.attributes["POSITION"] = pa;
+    // Materials, with their base colour images referenced beside the output.
+    for (const MeshMaterial& m : mesh.materials) {
+        tinygltf::Material gm;
+        gm.name = m.name;
+        gm.pbrMetallicRoughness.baseColorFactor = {m.base_color.r, m.base_color.g, m.base_color.b, m.base_color.a};
+        if (!m.base_color_texture.empty()) {
+            tinygltf::Image image;
+            image.uri = image_uri(m.base_color_texture, tmp.parent_path());
+            model.images.push_back(image);
+            tinygltf::Texture texture;
+            texture.source = int(model.images.size() - 1);
+            model.textures.push_back(texture);
+            gm.pbrMetallicRoughness.baseColorTexture.index = int(model.textures.size() - 1);
+            gm.pbrMetallicRoughness.baseColorTexture.texCoord = m.base_color_texcoord;
+        }
+        if (!m.occlusion_texture.empty()) {
+            tinygltf::Image image;
+            image.uri = image_uri(m.occlusion_texture, tmp.parent_path());
+            model.images.push_back(image);
+            tinygltf::Texture texture;
+            texture.source = int(model.images.size() - 1);
+            model.textures.push_back(texture);
+            gm.occlusionTexture.index = int(model.textures.size() - 1);
+            gm.occlusionTexture.texCoord = m.occlusion_texcoord;
+        }
+        model.materials.push_back(gm);
+    }
+
+    // One glTF mesh and node per part; a mesh without parts is one part.
+    const std::size_t groups = mesh.triangle_parts.empty() ? 1 : mesh.parts.size();
+    std::vector<std::vector<std::uint32_t>> group_triangles(groups);
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t)
+        group_triangles[mesh.triangle_parts.empty() ? 0 : mesh.triangle_parts[t]].push_back(std::uint32_t(t));
 
     Mesh copy_for_normals;
-    const std::vector<glm::vec3>* normals = &mesh.normals;
-    if (normals->empty()) {
+    const std::vector<glm::vec3>* all_normals = &mesh.normals;
+    if (all_normals->empty()) {
         copy_for_normals.positions = mesh.positions;
         copy_for_normals.indices = mesh.indices;
         compute_normals(copy_for_normals);
-        normals = &copy_for_normals.normals;
+        all_normals = &copy_for_normals.normals;
     }
-    const int nv = add_view(model, normals->data(), n * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER);
-    prim.attributes["NORMAL"] = add_accessor(model, nv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n);
-
-    if (!mesh.colors.empty()) {
-        const int cv = add_view(model, mesh.colors.data(), n * sizeof(glm::vec4), TINYGLTF_TARGET_ARRAY_BUFFER);
-        prim.attributes["COLOR_0"] = add_accessor(model, cv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, n);
-    }
-    for (const auto& a : mesh.attributes) {
-        const int av = add_view(model, a.values.data(), a.values.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
-        prim.attributes[gltf_attribute_name(a.name)] =
-            add_accessor(model, av, TINYGLTF_COMPONENT_TYPE_FLOAT, vec_type(a.components), n);
-    }
-    const int iv = add_view(model, mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t),
-                            TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
-    prim.indices = add_accessor(model, iv, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR,
-                                mesh.indices.size());
-
-    tinygltf::Mesh gm;
-    gm.primitives.push_back(prim);
-    model.meshes.push_back(gm);
-    tinygltf::Node node;
-    node.mesh = 0;
-    model.nodes.push_back(node);
     tinygltf::Scene scene;
-    scene.nodes.push_back(0);
+    for (std::size_t g = 0; g < groups; ++g) {
+        if (groups > 1 && group_triangles[g].empty())
+            continue;
+        // The group's vertices, in the mesh's order; all of them for a mesh of one part.
+        std::vector<std::uint32_t> used;
+        std::vector<std::uint32_t> local(mesh.vertex_count(), 0);
+        if (groups == 1) {
+            used.resize(mesh.vertex_count());
+            for (std::size_t v = 0; v < used.size(); ++v)
+                used[v] = local[v] = std::uint32_t(v);
+        } else {
+            std::vector<bool> in(mesh.vertex_count(), false);
+            for (std::uint32_t t : group_triangles[g])
+                for (int k = 0; k < 3; ++k)
+                    in[mesh.indices[3 * t + std::size_t(k)]] = true;
+            for (std::size_t v = 0; v < in.size(); ++v)
+                if (in[v]) {
+                    local[v] = std::uint32_t(used.size());
+                    used.push_back(std::uint32_t(v));
+                }
+        }
+        auto gather = [&](const auto& src) {
+            std::vector<std::decay_t<decltype(src[0])>> out;
+            out.reserve(used.size());
+            for (std::uint32_t v : used)
+                out.push_back(src[v]);
+            return out;
+        };
+        tinygltf::Primitive prim;
+        prim.mode = TINYGLTF_MODE_TRIANGLES;
+        const std::size_t n = used.size();
+
+        const std::vector<glm::vec3> positions = gather(mesh.positions);
+        const int pv = add_view(model, positions.data(), n * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER);
+        const int pa = add_accessor(model, pv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n);
+        glm::vec3 lo = positions[0], hi = positions[0]; // POSITION requires min and max
+        for (const glm::vec3& p : positions)
+            lo = glm::min(lo, p), hi = glm::max(hi, p);
+        model.accessors[std::size_t(pa)].minValues = {lo.x, lo.y, lo.z};
+        model.accessors[std::size_t(pa)].maxValues = {hi.x, hi.y, hi.z};
+        prim.attributes["POSITION"] = pa;
+
+        const std::vector<glm::vec3> normals = gather(*all_normals);
+        const int nv = add_view(model, normals.data(), n * sizeof(glm::vec3), TINYGLTF_TARGET_ARRAY_BUFFER);
+        prim.attributes["NORMAL"] = add_accessor(model, nv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, n);
+
+        if (!mesh.colors.empty()) {
+            const std::vector<glm::vec4> colors = gather(mesh.colors);
+            const int cv = add_view(model, colors.data(), n * sizeof(glm::vec4), TINYGLTF_TARGET_ARRAY_BUFFER);
+            prim.attributes["COLOR_0"] = add_accessor(model, cv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC4, n);
+        }
+        for (std::size_t k = 0; k < mesh.texcoords.size(); ++k) {
+            const std::vector<glm::vec2> uv = gather(mesh.texcoords[k]);
+            const int tv = add_view(model, uv.data(), n * sizeof(glm::vec2), TINYGLTF_TARGET_ARRAY_BUFFER);
+            prim.attributes["TEXCOORD_" + std::to_string(k)] =
+                add_accessor(model, tv, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, n);
+        }
+        for (const auto& a : mesh.attributes) {
+            std::vector<float> values;
+            values.reserve(n * std::size_t(a.components));
+            for (std::uint32_t v : used)
+                for (int c = 0; c < a.components; ++c)
+                    values.push_back(a.values[std::size_t(v) * std::size_t(a.components) + std::size_t(c)]);
+            const int av = add_view(model, values.data(), values.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
+            prim.attributes[gltf_attribute_name(a.name)] =
+                add_accessor(model, av, TINYGLTF_COMPONENT_TYPE_FLOAT, vec_type(a.components), n);
+        }
+        std::vector<std::uint32_t> indices;
+        if (groups == 1 && mesh.triangle_parts.empty()) {
+            indices = mesh.indices;
+        } else {
+            for (std::uint32_t t : group_triangles[g])
+                for (int k = 0; k < 3; ++k)
+                    indices.push_back(local[mesh.indices[3 * t + std::size_t(k)]]);
+        }
+        const int iv = add_view(model, indices.data(), indices.size() * sizeof(std::uint32_t),
+                                TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+        prim.indices =
+            add_accessor(model, iv, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, indices.size());
+
+        tinygltf::Mesh gm;
+        tinygltf::Node node;
+        if (!mesh.triangle_parts.empty()) {
+            prim.material = mesh.parts[g].material;
+            gm.name = node.name = mesh.parts[g].name;
+        }
+        gm.primitives.push_back(prim);
+        model.meshes.push_back(gm);
+        node.mesh = int(model.meshes.size() - 1);
+        model.nodes.push_back(node);
+        scene.nodes.push_back(int(model.nodes.size() - 1));
+    }
     model.scenes.push_back(scene);
     model.defaultScene = 0;
 

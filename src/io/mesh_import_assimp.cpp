@@ -5,10 +5,12 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string_view>
 
 #include <assimp/Importer.hpp>
+#include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fmt/format.h>
@@ -29,6 +31,8 @@ struct Flattener {
     RawImport out;
     bool any_missing_normals = false;
     bool any_colors = false;
+    std::filesystem::path source_dir{}; // image paths are relative to it
+    std::map<unsigned, int> materials{};
 
     void visit(const aiNode* node, const aiMatrix4x4& parent, unsigned depth) {
         if (depth > kMaxNodeDepth)
@@ -39,15 +43,59 @@ struct Flattener {
                 throw Error(fmt::format("node '{}' references mesh {} of {}", node->mName.C_Str(), node->mMeshes[i],
                                         scene->mNumMeshes),
                             where);
-            append(scene->mMeshes[node->mMeshes[i]], world);
+            append(scene->mMeshes[node->mMeshes[i]], world, node->mName.C_Str());
         }
         for (unsigned c = 0; c < node->mNumChildren; ++c)
             visit(node->mChildren[c], world, depth + 1);
     }
 
-    void append(const aiMesh* m, const aiMatrix4x4& world) {
+    // The Mesh material for Assimp's material `index`, added on first use:
+    // the base colour (or diffuse) factor and image path.
+    int material(unsigned index) {
+        if (index >= scene->mNumMaterials)
+            return -1;
+        if (auto it = materials.find(index); it != materials.end())
+            return it->second;
+        const aiMaterial* am = scene->mMaterials[index];
+        MeshMaterial mm;
+        aiString name;
+        if (am->Get(AI_MATKEY_NAME, name) == AI_SUCCESS)
+            mm.name = name.C_Str();
+        aiColor4D c;
+        if (am->Get(AI_MATKEY_BASE_COLOR, c) == AI_SUCCESS || am->Get(AI_MATKEY_COLOR_DIFFUSE, c) == AI_SUCCESS)
+            mm.base_color = glm::vec4(c.r, c.g, c.b, c.a);
+        for (aiTextureType type : {aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE}) {
+            aiString path;
+            unsigned uv = 0;
+            if (am->GetTexture(type, 0, &path, nullptr, &uv) != AI_SUCCESS || path.length == 0)
+                continue;
+            if (path.C_Str()[0] != '*') // "*0": embedded in the file, not carried
+                mm.base_color_texture = (source_dir / path.C_Str()).lexically_normal().string();
+            mm.base_color_texcoord = int(uv);
+            break;
+        }
+        out.mesh.materials.push_back(std::move(mm));
+        return materials[index] = int(out.mesh.materials.size() - 1);
+    }
+
+    void append(const aiMesh* m, const aiMatrix4x4& world, const std::string& node_name) {
         Mesh& mesh = out.mesh;
         const std::size_t base = mesh.positions.size();
+        mesh.parts.push_back({node_name, material(m->mMaterialIndex)});
+        const auto part = std::uint32_t(mesh.parts.size() - 1);
+        // UV sets, with v flipped to glTF's convention (Assimp's grows upwards).
+        for (unsigned k = 0; k < AI_MAX_NUMBER_OF_TEXTURECOORDS; ++k) {
+            if (!m->mTextureCoords[k])
+                continue;
+            if (mesh.texcoords.size() <= k)
+                mesh.texcoords.resize(k + 1);
+            auto& uv = mesh.texcoords[k];
+            uv.resize(base, glm::vec2(0.0f));
+            for (unsigned v = 0; v < m->mNumVertices; ++v)
+                uv.emplace_back(m->mTextureCoords[k][v].x, 1.0f - m->mTextureCoords[k][v].y);
+        }
+        for (auto& uv : mesh.texcoords)
+            uv.resize(base + m->mNumVertices, glm::vec2(0.0f));
         check_counts(base + m->mNumVertices, mesh.triangle_count() + m->mNumFaces, limits, where);
         ++out.report.source_meshes;
         aiMatrix3x3 normal_matrix(world);
@@ -83,6 +131,7 @@ struct Flattener {
                                 where);
                 mesh.indices.push_back(std::uint32_t(base + face.mIndices[k]));
             }
+            mesh.triangle_parts.push_back(part);
         }
     }
 };
@@ -179,6 +228,8 @@ RawImport read_assimp_here(const void* data, std::size_t size, const std::string
         throw Error("file contains no meshes", where);
 
     Flattener flat{scene, limits, where, {}};
+    if (path)
+        flat.source_dir = path->parent_path();
     flat.out.report.format = extension_hint;
     flat.visit(scene->mRootNode, aiMatrix4x4(), 0);
     if (flat.any_missing_normals)

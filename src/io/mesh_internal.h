@@ -3,6 +3,9 @@
 
 #include <functional>
 #include <string>
+#include <vector>
+
+#include <glm/mat3x3.hpp>
 
 #include "skybake/mesh.h"
 
@@ -15,9 +18,24 @@ struct RawImport {
     ImportReport report;
 };
 
+// Where one triangle primitive of one node landed in a glTF import's flat
+// mesh: vertices [first_vertex, first_vertex + vertex_count), in the
+// primitive's own order.
+struct GltfPrimitiveInstance {
+    int node = -1, mesh = -1, primitive = -1;
+    std::size_t first_vertex = 0, vertex_count = 0;
+    glm::dmat3 world_from_mesh{1.0}; // linear part of the node's world transform
+};
+
+// What read_gltf() saw of the document, for writing a bake back into it.
+struct GltfSceneMap {
+    std::vector<GltfPrimitiveInstance> instances; // in the order of the flat mesh
+    std::vector<std::vector<unsigned char>> buffers; // every buffer's bytes, decoded
+};
+
 // Readers. `where` names the source in error messages.
 RawImport read_gltf(const void* data, std::size_t size, bool binary, const std::string& base_dir,
-                    const std::string& where, const ImportLimits& limits);
+                    const std::string& where, const ImportLimits& limits, GltfSceneMap* scene = nullptr);
 RawImport read_ply(const void* data, std::size_t size, const std::string& where, const ImportLimits& limits);
 // With `path`, Assimp reads the file itself (data may be null); otherwise from memory.
 RawImport read_assimp(const void* data, std::size_t size, const std::string& extension_hint, const std::string& where,

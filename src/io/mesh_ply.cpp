@@ -250,10 +250,10 @@ RawImport read_ply(const void* data, std::size_t size, const std::string& where,
             have_vertices = true;
             check_counts(e.count, 0, limits, where);
             // Map properties to destinations.
-            enum Kind { Skip, Pos, Nrm, Col, Attr };
+            enum Kind { Skip, Pos, Nrm, Col, Attr, Uv };
             struct Slot { Kind kind = Skip; int comp = 0; std::size_t attr = 0; };
             std::vector<Slot> slots(e.properties.size());
-            bool has_pos[3] = {}, has_nrm[3] = {}, has_col = false;
+            bool has_pos[3] = {}, has_nrm[3] = {}, has_col = false, has_uv[2] = {};
             bool col_float = false;
             for (std::size_t i = 0; i < e.properties.size(); ++i) {
                 const Property& p = e.properties[i];
@@ -272,6 +272,13 @@ RawImport read_ply(const void* data, std::size_t size, const std::string& where,
                         has_col = true;
                         col_float = p.type == PlyType::F32 || p.type == PlyType::F64;
                     }
+                // Texture coordinates, as the PLY writers in use name them.
+                static const char* un[] = {"s", "u", "texture_u", "texture_s"};
+                static const char* vn[] = {"t", "v", "texture_v", "texture_t"};
+                for (int k = 0; k < 4; ++k) {
+                    if (p.name == un[k] && !has_uv[0]) { slots[i] = {Uv, 0}; has_uv[0] = true; }
+                    if (p.name == vn[k] && !has_uv[1]) { slots[i] = {Uv, 1}; has_uv[1] = true; }
+                }
                 if (slots[i].kind != Skip || !is_valid_attribute_name(p.name))
                     continue;
                 // "name_x", "name_y", ... following each other form one attribute.
@@ -299,6 +306,13 @@ RawImport read_ply(const void* data, std::size_t size, const std::string& where,
                 for (Slot& s : slots)
                     if (s.kind == Nrm)
                         s.kind = Skip;
+            const bool uvs = has_uv[0] && has_uv[1];
+            if (!uvs) // a lone s or u is ignored
+                for (Slot& s : slots)
+                    if (s.kind == Uv)
+                        s.kind = Skip;
+            if (uvs)
+                mesh.texcoords.assign(1, std::vector<glm::vec2>(e.count, glm::vec2(0.0f)));
             mesh.positions.resize(e.count);
             if (normals)
                 mesh.normals.resize(e.count);
@@ -323,6 +337,11 @@ RawImport read_ply(const void* data, std::size_t size, const std::string& where,
                     case Pos: mesh.positions[v][s.comp] = body.number_f32(p.type); break;
                     case Nrm: mesh.normals[v][s.comp] = body.number_f32(p.type); break;
                     case Col: mesh.colors[v][s.comp] = float(body.number(p.type)) * col_scale; break;
+                    case Uv: { // PLY's t grows upwards, glTF's v downwards
+                        const float x = body.number_f32(p.type);
+                        mesh.texcoords[0][v][s.comp] = s.comp == 0 ? x : 1.0f - x;
+                        break;
+                    }
                     case Attr: {
                         auto& a = mesh.attributes[s.attr];
                         a.values[v * std::size_t(a.components) + std::size_t(s.comp)] = body.number_f32(p.type);
@@ -417,6 +436,9 @@ void write_ply(const std::filesystem::path& tmp, const Mesh& mesh, PlyEncoding e
     const bool colors = !mesh.colors.empty();
     if (colors)
         header += "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\n";
+    const bool uvs = !mesh.texcoords.empty();
+    if (uvs) // TEXCOORD_0 only; t grows upwards
+        header += "property float s\nproperty float t\n";
     static const char* suffix[] = {"_x", "_y", "_z", "_w"};
     for (const auto& a : mesh.attributes) {
         if (a.components == 1)
@@ -484,6 +506,10 @@ void write_ply(const std::filesystem::path& tmp, const Mesh& mesh, PlyEncoding e
         if (colors)
             for (int k = 0; k < 4; ++k)
                 put_u8(u8(mesh.colors[v][k]));
+        if (uvs) {
+            put_f(mesh.texcoords[0][v].x);
+            put_f(1.0f - mesh.texcoords[0][v].y);
+        }
         for (const auto& a : mesh.attributes)
             for (int k = 0; k < a.components; ++k)
                 put_f(a.values[v * std::size_t(a.components) + std::size_t(k)]);

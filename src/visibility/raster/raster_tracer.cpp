@@ -89,7 +89,6 @@ struct RasterTracer::State {
     gl::VertexArray vao;
     gl::Buffer positions, indices;
     GLsizei index_count = 0;
-    std::vector<glm::vec3> vertex_positions; // the directional method's offset directions
     glm::vec3 centre{0.0f};
     float radius = 0.0f;
     bool have_mesh = false;
@@ -219,7 +218,6 @@ void RasterTracer::set_mesh(const Mesh& mesh, BackFaces back_faces) {
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(mesh.indices.size() * sizeof(std::uint32_t)), mesh.indices.data(),
                  GL_STATIC_DRAW);
     s_->index_count = GLsizei(mesh.indices.size());
-    s_->vertex_positions = mesh.positions;
     glBindVertexArray(0);
     const Bounds bounds = compute_bounds(mesh);
     s_->centre = 0.5f * (bounds.min + bounds.max);
@@ -466,11 +464,9 @@ void RasterTracer::trace_directional(const TraceChunk& chunk) {
         g = GpuVertex{};
         g.origin = glm::vec4(chunk.origins[i], 1.0f);
         g.n = glm::vec4(chunk.normals[i], 0.0f);
-        // The direction the driver moved the origin off the vertex: the
+        // The direction the driver moved the origin off its point: the
         // normal, or on borders and creases the normal plus a tangent.
-        const glm::vec3 off = chunk.origins[i] - s.vertex_positions[chunk.first + i];
-        const float len = glm::length(off);
-        g.t = glm::vec4(len > 0.0f ? off / len : chunk.normals[i], 0.0f);
+        g.t = glm::vec4(chunk.offsets.empty() ? chunk.normals[i] : chunk.offsets[i], 0.0f);
     }
     upload(s.vertex_buffer, vertices);
     // Every origin is inside the padded bounding sphere (origins sit a rounding

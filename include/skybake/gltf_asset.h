@@ -1,0 +1,107 @@
+// skybake/gltf_asset.h: bake into a user's glTF 2.0 document and keep
+// everything else in it.
+//
+// [SECTION] What survives
+// [SECTION] The asset
+//
+// load_mesh() flattens a scene into one Mesh and forgets the rest of the
+// file. A GltfAsset keeps the document itself: its JSON, member for member
+// and in the file's own key order, and its buffers, byte for byte. Its
+// mesh() is the same flat world-space Mesh that load_mesh() returns, which a
+// bake fills with attributes; save() then writes the input document back
+// with those attributes added to each primitive.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include "skybake/mesh.h"
+
+namespace skybake {
+
+// [SECTION] What survives -----------------------------------------------------------
+//
+// Every member of the input JSON is written back unchanged: nodes, hierarchy
+// and transforms, materials, textures, images and samplers, every vertex
+// attribute (TEXCOORD_n, COLOR_n, JOINTS_n, WEIGHTS_n, ...), skins, morph
+// targets, animations, cameras, extensions and extras, including those that
+// no reader here understands. The changes are:
+//   - each triangle primitive gets one new float accessor per new or changed
+//     attribute of mesh() ("ao" -> "_AO"), in the primitive's own vertex
+//     order, with its data appended to buffer 0 (the bytes before it are the
+//     input's buffer 0, unchanged);
+//   - a mesh that several nodes use is baked per instance: the first node (in
+//     scene order) keeps the mesh, and each further node gets a copy of it,
+//     appended to "meshes" and named by the node's "mesh", that differs only
+//     by its own attribute accessors;
+//   - three-component attributes whose name ends in "normal" (bent_normal)
+//     are directions: they are turned from world space into the mesh's frame
+//     with the transpose of the node's linear transform and renormalised,
+//     the inverse of how NORMAL is carried to world space. Other attributes
+//     are scalars and are written as they are;
+//   - new or changed colours of mesh() (a bake's AO as grey) become
+//     COLOR_0 of the primitives that have none; a file's own COLOR_0 is kept;
+//   - asset.generator gets "skybake" appended;
+//   - with set_occlusion_texture(), one image and texture are appended, and
+//     the baked primitives' materials get an occlusionTexture;
+//   - buffers[0].byteLength grows; in a .glb buffer 0 is the BIN chunk (no
+//     uri), in a .gltf it is embedded as a base64 data URI;
+//   - relative URIs of images and of other buffers are rewritten to stay
+//     valid from the output's folder (unchanged when it is the input's).
+// Points, lines, primitives that no scene node reaches, skins and morph
+// targets are not posed: a skinned or morphed mesh is baked where its node
+// puts it, in its rest pose, and animation is ignored.
+
+// [SECTION] The asset ----------------------------------------------------------------
+
+class GltfAsset {
+public:
+    // Reads a glTF 2.0 .gltf (external or embedded buffers) or .glb with the
+    // same checks and limits as load_mesh(). Throws skybake::Error for a file
+    // load_mesh() refuses, and for a glTF 1.0 file or another format (use
+    // is_gltf2() first and load_mesh() for those).
+    static GltfAsset load(const std::filesystem::path& path, const ImportLimits& limits = {});
+
+    // True when `path` ends in .gltf or .glb and holds glTF 2.0. Reads the
+    // file; throws skybake::Error as load_mesh() does when it is missing or
+    // malformed.
+    static bool is_gltf2(const std::filesystem::path& path, const ImportLimits& limits = {});
+
+    GltfAsset(GltfAsset&&) noexcept;
+    GltfAsset& operator=(GltfAsset&&) noexcept;
+    ~GltfAsset();
+
+    // The default scene flattened into world space, one copy of each
+    // primitive per node that uses it, as load_mesh() reads it. Add or
+    // replace attributes freely; positions, indices and the vertex count must
+    // stay as they are.
+    Mesh& mesh();
+    const Mesh& mesh() const;
+    const ImportReport& report() const;
+
+    // Primitive instances (node, primitive pairs) in mesh(), and how many of
+    // them save() writes as copies of a mesh that another node also uses.
+    std::size_t instance_count() const;
+    std::size_t shared_instance_count() const;
+
+    // Makes save() wire `image` (a path, as the output will find it) as the
+    // occlusionTexture of every material that a baked primitive uses, read
+    // with UV set `uv_set`; primitives without a material get a new one that
+    // has only that texture. An occlusionTexture the material had is replaced.
+    void set_occlusion_texture(const std::filesystem::path& image, int uv_set);
+
+    // Writes the document to a .glb or .gltf file (temporary file, then
+    // rename) with the attributes of mesh() that are new or changed since
+    // load(). Throws skybake::Error on another extension, a mesh whose vertex
+    // count changed, or I/O failure.
+    void save(const std::filesystem::path& path) const;
+
+private:
+    struct State;
+    explicit GltfAsset(std::unique_ptr<State> state);
+    std::unique_ptr<State> state_;
+};
+
+} // namespace skybake

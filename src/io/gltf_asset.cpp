@@ -1,0 +1,386 @@
+// A glTF 2.0 document kept whole, with baked attributes written back into it.
+// Khronos Group, "glTF 2.0 Specification", 2017-2021 (section 3.7.2.1: custom
+// attributes start with "_"; section 4.4: the GLB container).
+//
+// tinygltf reads the geometry (read_gltf(), with its bounds checks); the
+// document itself is edited as JSON. A tinygltf model written back would
+// drop members it does not know and spell defaults it does, so the output
+// would differ from the input in more than the new attributes.
+#include "skybake/gltf_asset.h"
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include <fmt/format.h>
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+#include <nlohmann/json.hpp>
+
+#include "io/gltf_schema.h"
+#include "io/mesh_internal.h"
+#include "skybake/error.h"
+#include "skybake/files.h"
+
+namespace skybake {
+
+namespace {
+
+using Json = nlohmann::ordered_json; // keeps the file's key order
+
+constexpr std::uint32_t kGlbMagic = 0x46546C67;  // "glTF"
+constexpr std::uint32_t kChunkJson = 0x4E4F534A; // "JSON"
+constexpr std::uint32_t kChunkBin = 0x004E4942;  // "BIN\0"
+constexpr int kFloat = 5126;                     // GL_FLOAT
+constexpr int kArrayBuffer = 34962;              // GL_ARRAY_BUFFER
+
+std::string lower_ext(const std::filesystem::path& p) {
+    std::string e = p.extension().string();
+    for (char& c : e)
+        c = char(std::tolower(static_cast<unsigned char>(c)));
+    return e;
+}
+
+std::uint32_t read_u32(const std::string& data, std::size_t at) {
+    std::uint32_t v = 0;
+    std::memcpy(&v, data.data() + at, 4);
+    return v;
+}
+
+// The JSON chunk of a GLB file (the file is checked by check_gltf() first).
+std::string glb_json(const std::string& data, const std::string& where) {
+    if (data.size() < 20 || read_u32(data, 0) != kGlbMagic)
+        throw Error("not a GLB file (no 'glTF' magic)", where);
+    const std::uint32_t length = read_u32(data, 12), type = read_u32(data, 16);
+    if (type != kChunkJson || length > data.size() - 20)
+        throw Error("GLB file has no complete JSON chunk", where);
+    return data.substr(20, length);
+}
+
+std::string base64(const std::vector<unsigned char>& bytes) {
+    static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    out.reserve((bytes.size() + 2) / 3 * 4);
+    for (std::size_t i = 0; i < bytes.size(); i += 3) {
+        const std::uint32_t b0 = bytes[i], b1 = i + 1 < bytes.size() ? bytes[i + 1] : 0,
+                            b2 = i + 2 < bytes.size() ? bytes[i + 2] : 0;
+        const std::uint32_t v = (b0 << 16) | (b1 << 8) | b2;
+        out += table[(v >> 18) & 63];
+        out += table[(v >> 12) & 63];
+        out += i + 1 < bytes.size() ? table[(v >> 6) & 63] : '=';
+        out += i + 2 < bytes.size() ? table[v & 63] : '=';
+    }
+    return out;
+}
+
+// A relative URI of the input, as seen from the output's folder.
+std::string relocate_uri(const std::string& uri, const std::filesystem::path& from_dir,
+                         const std::filesystem::path& to_dir) {
+    namespace fs = std::filesystem;
+    if (uri.empty() || uri.rfind("data:", 0) == 0 || uri.find("://") != std::string::npos || uri[0] == '/')
+        return uri;
+    std::error_code ec;
+    if (fs::equivalent(from_dir, to_dir, ec))
+        return uri;
+    const fs::path rel =
+        fs::absolute(from_dir).lexically_normal().lexically_relative(fs::absolute(to_dir).lexically_normal());
+    if (rel.empty() || rel == ".")
+        return uri;
+    std::string prefix;
+    for (char c : rel.generic_string())
+        prefix += c == ' ' ? std::string("%20") : std::string(1, c);
+    return prefix + "/" + uri;
+}
+
+bool is_direction(const VertexAttribute& a) {
+    const std::string_view suffix = "normal";
+    return a.components == 3 && a.name.size() >= suffix.size() &&
+           a.name.compare(a.name.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+const char* accessor_type(int components) {
+    switch (components) {
+    case 1: return "SCALAR";
+    case 2: return "VEC2";
+    case 3: return "VEC3";
+    default: return "VEC4";
+    }
+}
+
+} // namespace
+
+struct GltfAsset::State {
+    std::filesystem::path source_dir;
+    Json document;
+    std::vector<std::vector<unsigned char>> buffers;
+    std::vector<io::GltfPrimitiveInstance> instances;
+    std::vector<VertexAttribute> loaded_attributes; // to tell new and changed ones
+    std::vector<glm::vec4> loaded_colors;
+    Mesh mesh;
+    ImportReport report;
+    std::filesystem::path occlusion_image; // empty: none
+    int occlusion_uv_set = 0;
+};
+
+void GltfAsset::set_occlusion_texture(const std::filesystem::path& image, int uv_set) {
+    state_->occlusion_image = image;
+    state_->occlusion_uv_set = uv_set;
+}
+
+GltfAsset::GltfAsset(std::unique_ptr<State> state) : state_(std::move(state)) {}
+GltfAsset::GltfAsset(GltfAsset&&) noexcept = default;
+GltfAsset& GltfAsset::operator=(GltfAsset&&) noexcept = default;
+GltfAsset::~GltfAsset() = default;
+
+Mesh& GltfAsset::mesh() {
+    return state_->mesh;
+}
+const Mesh& GltfAsset::mesh() const {
+    return state_->mesh;
+}
+const ImportReport& GltfAsset::report() const {
+    return state_->report;
+}
+std::size_t GltfAsset::instance_count() const {
+    return state_->instances.size();
+}
+
+std::size_t GltfAsset::shared_instance_count() const {
+    std::map<int, int> first_node; // mesh -> the node that keeps it
+    std::size_t shared = 0;
+    for (const auto& inst : state_->instances) {
+        const auto [it, inserted] = first_node.emplace(inst.mesh, inst.node);
+        if (!inserted && it->second != inst.node)
+            ++shared;
+    }
+    return shared;
+}
+
+bool GltfAsset::is_gltf2(const std::filesystem::path& path, const ImportLimits& limits) {
+    const std::string ext = lower_ext(path);
+    if (ext != ".gltf" && ext != ".glb")
+        return false;
+    const std::string data = read_file(path, limits.max_file_bytes);
+    if (data.empty())
+        throw Error("file is empty", path.string());
+    return io::check_gltf(data.data(), data.size(), ext == ".glb", path.string()) == 2;
+}
+
+GltfAsset GltfAsset::load(const std::filesystem::path& path, const ImportLimits& limits) {
+    const std::string where = path.string();
+    const std::string ext = lower_ext(path);
+    if (ext != ".gltf" && ext != ".glb")
+        throw Error("not a glTF file; only .gltf and .glb documents can be baked in place", where);
+    const bool binary = ext == ".glb";
+    const std::string data = read_file(path, limits.max_file_bytes);
+    if (data.empty())
+        throw Error("file is empty", where);
+    if (io::check_gltf(data.data(), data.size(), binary, where) != 2)
+        throw Error("glTF 1.0 documents cannot be baked in place; their geometry is read as any other format", where);
+
+    auto state = std::make_unique<State>();
+    state->source_dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+    io::GltfSceneMap map;
+    io::RawImport raw =
+        io::read_gltf(data.data(), data.size(), binary, state->source_dir.string(), where, limits, &map);
+    state->mesh = io::finish_import(std::move(raw), where, limits, &state->report);
+    state->instances = std::move(map.instances);
+    state->buffers = std::move(map.buffers);
+    state->loaded_attributes = state->mesh.attributes;
+    state->loaded_colors = state->mesh.colors;
+    try {
+        state->document = Json::parse(binary ? glb_json(data, where) : data);
+    } catch (const nlohmann::json::exception& e) {
+        throw Error(fmt::format("malformed glTF JSON: {}", e.what()), where);
+    }
+    return GltfAsset(std::move(state));
+}
+
+void GltfAsset::save(const std::filesystem::path& path) const {
+    const std::string where = path.string();
+    const std::string ext = lower_ext(path);
+    if (ext != ".glb" && ext != ".gltf")
+        throw Error(fmt::format("cannot write a glTF document as '{}'; use .glb or .gltf", ext), where);
+    const State& s = *state_;
+    const Mesh& mesh = s.mesh;
+    std::size_t loaded_vertices = 0;
+    for (const auto& inst : s.instances)
+        loaded_vertices = std::max(loaded_vertices, inst.first_vertex + inst.vertex_count);
+    if (mesh.vertex_count() != loaded_vertices)
+        throw Error(fmt::format("the mesh has {} vertices but the document's scene has {}; a GltfAsset's mesh "
+                                "may gain attributes but not change its vertices",
+                                mesh.vertex_count(), loaded_vertices),
+                    where);
+    validate_mesh(mesh, "mesh to write to " + where);
+
+    // The attributes to write: new ones, and those a bake changed.
+    std::vector<const VertexAttribute*> fresh;
+    for (const auto& a : mesh.attributes) {
+        const auto old = std::find_if(s.loaded_attributes.begin(), s.loaded_attributes.end(),
+                                      [&](const VertexAttribute& b) { return b.name == a.name; });
+        const bool same = old != s.loaded_attributes.end() && old->components == a.components &&
+                          old->values.size() == a.values.size() &&
+                          std::memcmp(old->values.data(), a.values.data(), a.values.size() * sizeof(float)) == 0;
+        if (!same)
+            fresh.push_back(&a);
+    }
+
+    // New colours (a bake's AO as grey) as a four-component attribute.
+    VertexAttribute colors{"color", 4, {}};
+    if (!mesh.colors.empty() &&
+        (mesh.colors.size() != s.loaded_colors.size() ||
+         std::memcmp(mesh.colors.data(), s.loaded_colors.data(), mesh.colors.size() * sizeof(glm::vec4)) != 0))
+        for (const glm::vec4& c : mesh.colors)
+            colors.values.insert(colors.values.end(), {c.r, c.g, c.b, c.a});
+
+    Json doc = s.document;
+    if (!doc.contains("buffers") || !doc["buffers"].is_array() || doc["buffers"].empty() || s.buffers.empty())
+        throw Error("the document has no buffer to append to", where);
+    std::vector<unsigned char> bin = s.buffers[0];
+    bin.resize(doc["buffers"][0].value("byteLength", std::size_t(0)), 0); // a GLB chunk may carry padding
+    if (!doc.contains("bufferViews"))
+        doc["bufferViews"] = Json::array();
+    if (!doc.contains("accessors"))
+        doc["accessors"] = Json::array();
+    Json& views = doc["bufferViews"];
+    Json& accessors = doc["accessors"];
+    Json& meshes = doc["meshes"];
+    const Json original_meshes = meshes;
+
+    std::map<int, int> first_node;      // mesh -> the node that keeps it
+    std::map<int, int> target_mesh;     // node -> the mesh its attributes go to
+    std::set<std::pair<int, int>> done; // (node, primitive) written
+    std::vector<float> local;
+    for (const auto& inst : s.instances) {
+        if (!done.insert({inst.node, inst.primitive}).second)
+            continue; // a node reached twice (an invalid hierarchy): its first visit counts
+        if (!target_mesh.count(inst.node)) {
+            const auto [it, inserted] = first_node.emplace(inst.mesh, inst.node);
+            if (inserted || it->second == inst.node) {
+                target_mesh[inst.node] = inst.mesh;
+            } else {
+                meshes.push_back(original_meshes[std::size_t(inst.mesh)]);
+                target_mesh[inst.node] = int(meshes.size() - 1);
+                doc["nodes"][std::size_t(inst.node)]["mesh"] = target_mesh[inst.node];
+            }
+        }
+        Json& prim = meshes[std::size_t(target_mesh[inst.node])]["primitives"][std::size_t(inst.primitive)];
+        const glm::dmat3 mesh_from_world_normal = glm::transpose(inst.world_from_mesh);
+        const auto append = [&](const VertexAttribute* a, const std::string& key) {
+            const std::size_t c = std::size_t(a->components);
+            local.assign(a->values.begin() + std::ptrdiff_t(inst.first_vertex * c),
+                         a->values.begin() + std::ptrdiff_t((inst.first_vertex + inst.vertex_count) * c));
+            if (is_direction(*a))
+                for (std::size_t v = 0; v < inst.vertex_count; ++v) {
+                    glm::dvec3 d =
+                        mesh_from_world_normal * glm::dvec3(local[3 * v], local[3 * v + 1], local[3 * v + 2]);
+                    const double len = glm::length(d);
+                    d = len > 0.0 ? d / len : d;
+                    local[3 * v] = float(d.x), local[3 * v + 1] = float(d.y), local[3 * v + 2] = float(d.z);
+                }
+            while (bin.size() % 4)
+                bin.push_back(0);
+            const std::size_t offset = bin.size(), bytes = local.size() * sizeof(float);
+            bin.resize(offset + bytes);
+            std::memcpy(bin.data() + offset, local.data(), bytes);
+            views.push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}, {"target", kArrayBuffer}});
+            accessors.push_back({{"bufferView", views.size() - 1},
+                                 {"componentType", kFloat},
+                                 {"count", inst.vertex_count},
+                                 {"type", accessor_type(a->components)}});
+            prim["attributes"][key] = accessors.size() - 1;
+        };
+        for (const VertexAttribute* a : fresh)
+            append(a, gltf_attribute_name(a->name));
+        // Baked colours (AO as grey, for viewers) only where the file has none.
+        if (!colors.values.empty() && !prim["attributes"].contains("COLOR_0"))
+            append(&colors, "COLOR_0");
+    }
+
+    if (!s.occlusion_image.empty()) {
+        // One image and texture, referenced from every baked primitive's material.
+        if (!doc.contains("images"))
+            doc["images"] = Json::array();
+        if (!doc.contains("textures"))
+            doc["textures"] = Json::array();
+        if (!doc.contains("materials"))
+            doc["materials"] = Json::array();
+        const std::filesystem::path out_dir = path.has_parent_path() ? path.parent_path() : ".";
+        std::error_code ec;
+        std::string uri;
+        for (char c : std::filesystem::absolute(s.occlusion_image, ec)
+                          .lexically_normal()
+                          .lexically_relative(std::filesystem::absolute(out_dir, ec).lexically_normal())
+                          .generic_string())
+            uri += c == ' ' ? std::string("%20") : std::string(1, c);
+        doc["images"].push_back({{"uri", uri}});
+        doc["textures"].push_back({{"source", doc["images"].size() - 1}});
+        const Json occlusion = {{"index", doc["textures"].size() - 1}, {"texCoord", s.occlusion_uv_set}};
+        std::set<std::size_t> wired;
+        int bare = -1; // the material for primitives without one
+        for (const auto& [node, m] : target_mesh)
+            for (Json& prim : meshes[std::size_t(m)]["primitives"]) {
+                if (prim.value("mode", 4) != 4)
+                    continue;
+                if (!prim.contains("material")) {
+                    if (bare < 0) {
+                        doc["materials"].push_back({{"name", "skybake occlusion"}});
+                        bare = int(doc["materials"].size() - 1);
+                    }
+                    prim["material"] = bare;
+                }
+                const std::size_t mat = prim["material"].get<std::size_t>();
+                if (mat < doc["materials"].size() && wired.insert(mat).second)
+                    doc["materials"][mat]["occlusionTexture"] = occlusion;
+            }
+    }
+
+    Json& asset = doc["asset"];
+    const std::string generator = asset.value("generator", std::string());
+    if (generator.find("skybake") == std::string::npos)
+        asset["generator"] = generator.empty() ? std::string("skybake") : generator + ", skybake";
+
+    const std::filesystem::path out_dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+    if (doc.contains("images") && doc["images"].is_array())
+        for (Json& image : doc["images"])
+            if (image.contains("uri") && image["uri"].is_string())
+                image["uri"] = relocate_uri(image["uri"].get<std::string>(), s.source_dir, out_dir);
+    Json& buffers = doc["buffers"];
+    for (std::size_t i = 1; i < buffers.size(); ++i)
+        if (buffers[i].contains("uri") && buffers[i]["uri"].is_string())
+            buffers[i]["uri"] = relocate_uri(buffers[i]["uri"].get<std::string>(), s.source_dir, out_dir);
+    buffers[0]["byteLength"] = bin.size();
+    if (ext == ".glb")
+        buffers[0].erase("uri");
+    else
+        buffers[0]["uri"] = "data:application/octet-stream;base64," + base64(bin);
+
+    write_file_atomic(path, [&](const std::filesystem::path& tmp) {
+        std::ofstream out(tmp, std::ios::binary);
+        if (!out)
+            throw Error("cannot create file", tmp.string());
+        std::string text = doc.dump();
+        if (ext == ".glb") {
+            while (text.size() % 4)
+                text += ' ';
+            while (bin.size() % 4)
+                bin.push_back(0);
+            const std::uint32_t header[3] = {kGlbMagic, 2, std::uint32_t(12 + 8 + text.size() + 8 + bin.size())};
+            const std::uint32_t json_head[2] = {std::uint32_t(text.size()), kChunkJson};
+            const std::uint32_t bin_head[2] = {std::uint32_t(bin.size()), kChunkBin};
+            out.write(reinterpret_cast<const char*>(header), sizeof header);
+            out.write(reinterpret_cast<const char*>(json_head), sizeof json_head);
+            out.write(text.data(), std::streamsize(text.size()));
+            out.write(reinterpret_cast<const char*>(bin_head), sizeof bin_head);
+            out.write(reinterpret_cast<const char*>(bin.data()), std::streamsize(bin.size()));
+        } else {
+            out << text;
+        }
+        if (!out.flush())
+            throw Error("cannot write glTF", tmp.string());
+    });
+}
+
+} // namespace skybake

@@ -1,0 +1,269 @@
+// glTF documents written back with new attributes: everything else survives.
+// Labelled "io": these also run under AddressSanitizer + UBSan (make test-sanitize).
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "skybake/error.h"
+#include "skybake/files.h"
+#include "skybake/gltf_asset.h"
+#include "skybake/mesh.h"
+
+using namespace skybake;
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+namespace {
+
+const fs::path kGltf2 = fs::path(SKYBAKE_ASSIMP_MODELS) / "glTF2";
+
+fs::path temp_dir(const std::string& name) {
+    const fs::path dir = fs::temp_directory_path() / ("skybake-gltf-asset-test-" + std::to_string(::getpid())) / name;
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+// A sample's folder copied to a fresh temporary folder; returns the copy of `file`.
+fs::path copy_sample(const std::string& folder, const std::string& file, const std::string& name) {
+    const fs::path dir = temp_dir(name);
+    fs::copy(kGltf2 / folder, dir, fs::copy_options::recursive);
+    return dir / file;
+}
+
+struct Document {
+    Json json;
+    std::string bin; // buffer 0: the GLB chunk, or the external file
+};
+
+std::uint32_t u32(const std::string& s, std::size_t at) {
+    std::uint32_t v;
+    std::memcpy(&v, s.data() + at, 4);
+    return v;
+}
+
+Document read_document(const fs::path& path) {
+    const std::string data = read_file(path);
+    Document d;
+    if (path.extension() == ".glb") {
+        const std::uint32_t json_len = u32(data, 12);
+        d.json = Json::parse(data.substr(20, json_len));
+        const std::size_t bin_at = 20 + json_len;
+        if (bin_at + 8 <= data.size())
+            d.bin = data.substr(bin_at + 8, u32(data, bin_at));
+    } else {
+        d.json = Json::parse(data);
+        const std::string uri = d.json["buffers"][0].value("uri", "");
+        if (!uri.empty() && uri.rfind("data:", 0) != 0)
+            d.bin = read_file(path.parent_path() / uri);
+    }
+    return d;
+}
+
+// Float VEC-n accessor values of an output document (buffer 0 only).
+std::vector<float> floats(const Document& d, int accessor) {
+    const Json& a = d.json["accessors"][std::size_t(accessor)];
+    const Json& v = d.json["bufferViews"][a["bufferView"].get<std::size_t>()];
+    EXPECT_EQ(a["componentType"], 5126);
+    EXPECT_EQ(v.value("buffer", 0), 0);
+    const std::string type = a["type"];
+    const std::size_t n = type == "SCALAR" ? 1 : std::size_t(type[3] - '0');
+    const std::size_t stride = v.value("byteStride", std::size_t(n * 4));
+    const std::size_t base = v.value("byteOffset", std::size_t(0)) + a.value("byteOffset", std::size_t(0));
+    std::vector<float> out(a["count"].get<std::size_t>() * n);
+    for (std::size_t i = 0; i < a["count"].get<std::size_t>(); ++i)
+        std::memcpy(&out[i * n], d.bin.data() + base + i * stride, n * 4);
+    return out;
+}
+
+// Fills the asset's mesh with a world-space "ao" (different on each instance)
+// and a "bent_normal" equal to the world normal.
+void fill(GltfAsset& asset) {
+    Mesh& m = asset.mesh();
+    std::vector<float> ao(m.vertex_count()), bent(3 * m.vertex_count());
+    for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+        const glm::vec3 p = m.positions[v];
+        ao[v] = 0.5f + 0.5f * std::sin(3.0f * p.x + 5.0f * p.y + 7.0f * p.z);
+        bent[3 * v] = m.normals[v].x, bent[3 * v + 1] = m.normals[v].y, bent[3 * v + 2] = m.normals[v].z;
+    }
+    m.set_attribute("ao", 1, std::move(ao));
+    m.set_attribute("bent_normal", 3, std::move(bent));
+}
+
+// Removes from `out` what a bake adds, checking each addition on the way;
+// what is left must equal the input.
+void strip_additions(Json& out, const Json& in, std::size_t in_bin_bytes) {
+    const std::size_t n_acc = in.value("accessors", Json::array()).size();
+    const std::size_t n_views = in.value("bufferViews", Json::array()).size();
+    const std::size_t n_meshes = in["meshes"].size();
+    for (Json& mesh : out["meshes"])
+        for (Json& prim : mesh["primitives"]) {
+            if (prim.value("mode", 4) != 4)
+                continue;
+            const std::size_t count = out["accessors"][prim["attributes"]["POSITION"].get<std::size_t>()]["count"];
+            for (const char* key : {"_AO", "_BENT_NORMAL"}) {
+                ASSERT_TRUE(prim["attributes"].contains(key)) << key;
+                const std::size_t a = prim["attributes"][key];
+                ASSERT_GE(a, n_acc);
+                const Json& acc = out["accessors"][a];
+                EXPECT_EQ(acc["count"], count);
+                EXPECT_EQ(acc["componentType"], 5126);
+                const Json& view = out["bufferViews"][acc["bufferView"].get<std::size_t>()];
+                EXPECT_GE(acc["bufferView"].get<std::size_t>(), n_views);
+                EXPECT_GE(view["byteOffset"].get<std::size_t>(), in_bin_bytes) << "new data is appended";
+                prim["attributes"].erase(key);
+            }
+        }
+    for (std::size_t i = 0; i < out["nodes"].size(); ++i) {
+        Json& node = out["nodes"][i];
+        if (node.contains("mesh") && node["mesh"].get<std::size_t>() >= n_meshes) {
+            const Json& original = in["nodes"][i]["mesh"];
+            EXPECT_EQ(out["meshes"][node["mesh"].get<std::size_t>()], in["meshes"][original.get<std::size_t>()])
+                << "node " << i << " got a copy of its mesh";
+            node["mesh"] = original;
+        }
+    }
+    out["meshes"].get_ref<Json::array_t&>().resize(n_meshes);
+    if (n_acc == 0)
+        out.erase("accessors");
+    else
+        out["accessors"].get_ref<Json::array_t&>().resize(n_acc);
+    if (n_views == 0)
+        out.erase("bufferViews");
+    else
+        out["bufferViews"].get_ref<Json::array_t&>().resize(n_views);
+    const std::string generator = out["asset"]["generator"];
+    EXPECT_NE(generator.find("skybake"), std::string::npos);
+    if (in["asset"].contains("generator"))
+        out["asset"]["generator"] = in["asset"]["generator"];
+    else
+        out["asset"].erase("generator");
+    EXPECT_GE(out["buffers"][0]["byteLength"].get<std::size_t>(), in["buffers"][0]["byteLength"].get<std::size_t>());
+    out["buffers"][0]["byteLength"] = in["buffers"][0]["byteLength"];
+    if (in["buffers"][0].contains("uri"))
+        out["buffers"][0]["uri"] = in["buffers"][0]["uri"];
+}
+
+// The bent normals written in each primitive are the file's own normals,
+// normalised: world normals carried back to the mesh's frame.
+std::size_t expect_bent_normals_are_local_normals(const Document& out) {
+    std::size_t checked = 0;
+    for (const Json& mesh : out.json["meshes"])
+        for (const Json& prim : mesh["primitives"]) {
+            const Json& attrs = prim["attributes"];
+            if (!attrs.contains("NORMAL") || !attrs.contains("_BENT_NORMAL"))
+                continue;
+            const std::vector<float> n = floats(out, attrs["NORMAL"]), b = floats(out, attrs["_BENT_NORMAL"]);
+            EXPECT_EQ(n.size(), b.size());
+            for (std::size_t i = 0; i + 2 < std::min(n.size(), b.size()); i += 3) {
+                const glm::vec3 nl = glm::normalize(glm::vec3(n[i], n[i + 1], n[i + 2]));
+                const glm::vec3 bl(b[i], b[i + 1], b[i + 2]);
+                EXPECT_NEAR(glm::length(nl - bl), 0.0f, 2e-5f) << "vertex " << i / 3;
+                ++checked;
+            }
+        }
+    return checked;
+}
+
+void round_trip(const fs::path& input, const std::string& output_name) {
+    GltfAsset asset = GltfAsset::load(input);
+    fill(asset);
+    const fs::path output = input.parent_path() / output_name;
+    asset.save(output);
+
+    const Document in = read_document(input), out = read_document(output);
+    // Buffer 0 is the input's, with the new data appended.
+    const std::size_t in_bytes = in.json["buffers"][0]["byteLength"];
+    if (!in.bin.empty()) {
+        ASSERT_GE(out.bin.size(), in_bytes);
+        EXPECT_EQ(out.bin.substr(0, in_bytes), in.bin.substr(0, in_bytes));
+    }
+    const bool has_normals = in.json.dump().find("\"NORMAL\"") != std::string::npos;
+    if (output.extension() == ".glb") {
+        EXPECT_EQ(expect_bent_normals_are_local_normals(out) > 0, has_normals);
+    }
+    Json stripped = out.json;
+    strip_additions(stripped, in.json, in_bytes);
+    EXPECT_EQ(stripped, in.json) << "diff: " << Json::diff(in.json, stripped).dump();
+
+    // Read back, the flat scene is the same, instance for instance.
+    const Mesh back = load_mesh(output);
+    ASSERT_EQ(back.vertex_count(), asset.mesh().vertex_count());
+    EXPECT_EQ(back.indices, asset.mesh().indices);
+    const VertexAttribute* ao = back.find_attribute("ao");
+    ASSERT_NE(ao, nullptr);
+    EXPECT_EQ(ao->values, asset.mesh().find_attribute("ao")->values);
+    for (std::size_t v = 0; v < back.vertex_count(); ++v)
+        ASSERT_EQ(back.positions[v], asset.mesh().positions[v]) << v;
+}
+
+} // namespace
+
+TEST(GltfAsset, BoxTexturedExternalBuffer) {
+    round_trip(copy_sample("BoxTextured-glTF", "BoxTextured.gltf", "box-external"), "out.glb");
+}
+
+TEST(GltfAsset, BoxTexturedBinary) {
+    round_trip(copy_sample("BoxTextured-glTF-Binary", "BoxTextured.glb", "box-binary"), "out.glb");
+}
+
+TEST(GltfAsset, BoxTexturedEmbeddedToGltf) {
+    round_trip(copy_sample("BoxTextured-glTF-Embedded", "BoxTextured.gltf", "box-embedded"), "out.gltf");
+}
+
+TEST(GltfAsset, TwoCylinderEngineInstances) {
+    const fs::path input = copy_sample("2CylinderEngine-glTF-Binary", "2CylinderEngine.glb", "engine");
+    const GltfAsset asset = GltfAsset::load(input);
+    EXPECT_GT(asset.shared_instance_count(), 0u); // the engine reuses meshes under several nodes
+    round_trip(input, "out.glb");
+}
+
+TEST(GltfAsset, SimpleSkin) {
+    round_trip(copy_sample("simple_skin", "simple_skin.gltf", "skin"), "out.glb");
+}
+
+TEST(GltfAsset, AnimatedMorphCube) {
+    round_trip(copy_sample("glTF-Sample-Models/AnimatedMorphCube-glTF", "AnimatedMorphCube.gltf", "morph"), "out.glb");
+}
+
+TEST(GltfAsset, TextureTransformKeepsItsExtension) {
+    const fs::path input = copy_sample("textureTransform", "TextureTransformTest.gltf", "texture-transform");
+    round_trip(input, "out.glb");
+    const Json out = read_document(input.parent_path() / "out.glb").json;
+    EXPECT_NE(out.dump().find("KHR_texture_transform"), std::string::npos);
+}
+
+TEST(GltfAsset, ImageUrisFollowTheOutputFolder) {
+    const fs::path input = copy_sample("BoxTextured-glTF", "BoxTextured.gltf", "box-moved");
+    GltfAsset asset = GltfAsset::load(input);
+    fill(asset);
+    const fs::path elsewhere = temp_dir("box-moved-out") / "sub";
+    fs::create_directories(elsewhere);
+    asset.save(elsewhere / "out.glb");
+    const Json out = read_document(elsewhere / "out.glb").json;
+    const std::string uri = out["images"][0]["uri"];
+    EXPECT_NE(uri, "CesiumLogoFlat.png");
+    EXPECT_TRUE(fs::is_regular_file(elsewhere / uri)) << uri;
+}
+
+TEST(GltfAsset, RefusesOtherFormatsAndChangedMeshes) {
+    EXPECT_FALSE(GltfAsset::is_gltf2(fs::path(SKYBAKE_ASSIMP_MODELS) / "PLY" / "cube.ply"));
+    EXPECT_FALSE(GltfAsset::is_gltf2(fs::path(SKYBAKE_ASSIMP_MODELS) / "glTF" / "CesiumMilkTruck" /
+                                     "CesiumMilkTruck.gltf")); // glTF 1.0
+    EXPECT_THROW(GltfAsset::load(fs::path(SKYBAKE_ASSIMP_MODELS) / "glTF" / "CesiumMilkTruck" / "CesiumMilkTruck.gltf"),
+                 Error);
+    const fs::path input = copy_sample("BoxTextured-glTF-Binary", "BoxTextured.glb", "box-changed");
+    GltfAsset asset = GltfAsset::load(input);
+    asset.mesh().positions.push_back({0, 0, 0});
+    EXPECT_THROW(asset.save(input.parent_path() / "out.glb"), Error);
+    EXPECT_FALSE(fs::exists(input.parent_path() / "out.glb"));
+    asset.mesh().positions.pop_back();
+    EXPECT_THROW(asset.save(input.parent_path() / "out.obj"), Error);
+}

@@ -1,0 +1,103 @@
+// skybake ao --texture: the AO texture file, its wiring as the glTF
+// material's occlusionTexture, and one-line errors that leave nothing behind.
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.h"
+#include "skybake/files.h"
+#include "skybake/image.h"
+
+using skybake::test::run_cli;
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+namespace {
+
+Json glb_json(const fs::path& path) {
+    const std::string data = skybake::read_file(path);
+    std::uint32_t len;
+    std::memcpy(&len, data.data() + 12, 4);
+    return Json::parse(data.substr(20, len));
+}
+
+// The milk truck (glTF 1.0, read through Assimp): a textured model whose UVs lie in [0, 1].
+fs::path truck(const std::string& name) {
+    const fs::path dir = skybake::test::temp_dir(name);
+    fs::copy(fs::path(SKYBAKE_ASSIMP_MODELS) / "glTF" / "CesiumMilkTruck", dir, fs::copy_options::recursive);
+    return dir / "CesiumMilkTruck.gltf";
+}
+
+void expect_one_line_and_nothing_written(const skybake::test::CliResult& r, const fs::path& dir,
+                                         const std::string& needle) {
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(r.err_lines(), 1) << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out.glb"));
+    EXPECT_FALSE(fs::exists(dir / "out_ao.png"));
+}
+
+} // namespace
+
+TEST(TextureCli, BakesAndWiresTheOcclusionTexture) {
+    const fs::path in = truck("texture-cli");
+    const fs::path dir = in.parent_path();
+    const auto r =
+        run_cli({"ao", in.string(), "-o", (dir / "out.glb").string(), "--texture", "128", "--rule", "lebedev:50",
+                 "--preview", (dir / "preview.png").string(), "--preview-size", "160x120", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const Json summary = Json::parse(r.out);
+    EXPECT_EQ(summary["texture"]["size"], 128);
+    EXPECT_GT(summary["texture"]["covered_texels"].get<double>(), 0.0);
+    EXPECT_GT(summary["texture"]["texels_per_second"].get<double>(), 0.0);
+    EXPECT_TRUE(fs::is_regular_file(dir / "out_ao.png"));
+    EXPECT_TRUE(fs::is_regular_file(dir / "preview.png"));
+    const skybake::Image ao = skybake::load_image(dir / "out_ao.png");
+    EXPECT_EQ(ao.width, 128);
+
+    const Json j = glb_json(dir / "out.glb");
+    bool textured = false;
+    for (const Json& material : j["materials"]) {
+        ASSERT_TRUE(material.contains("occlusionTexture")) << material.dump();
+        const std::size_t texture = material["occlusionTexture"]["index"];
+        const std::size_t image = j["textures"][texture]["source"];
+        EXPECT_EQ(j["images"][image]["uri"], "out_ao.png");
+        EXPECT_EQ(material["occlusionTexture"].value("texCoord", 0), 0); // 0 is the default
+        textured |= material["pbrMetallicRoughness"].contains("baseColorTexture");
+    }
+    EXPECT_TRUE(textured) << "the truck's own texture is still there";
+
+    // EXR output, named by --texture-out.
+    const auto e = run_cli({"ao", in.string(), "-o", (dir / "exr.glb").string(), "--texture", "64", "--rule",
+                            "lebedev:50", "--texture-out", (dir / "ao.exr").string()});
+    ASSERT_EQ(e.exit_code, 0) << e.err;
+    EXPECT_EQ(skybake::load_image(dir / "ao.exr").width, 64);
+}
+
+TEST(TextureCli, BadInputsGiveOneLineAndWriteNothing) {
+    const fs::path dir = skybake::test::temp_dir("texture-cli-bad");
+    // No UVs.
+    ASSERT_EQ(run_cli({"mesh", "generate", "--kind", "wall", "--triangles", "200", "-o", (dir / "wall.glb").string()})
+                  .exit_code,
+              0);
+    expect_one_line_and_nothing_written(
+        run_cli({"ao", (dir / "wall.glb").string(), "-o", (dir / "out.glb").string(), "--texture", "64"}), dir,
+        "no UVs");
+    // UVs outside [0, 1].
+    std::ofstream(dir / "tiled.ply") << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                        "property float z\nproperty float s\nproperty float t\nelement face 1\n"
+                                        "property list uchar int vertex_indices\nend_header\n"
+                                        "0 0 0 0 0\n1 0 0 2 0\n0 1 0 0 1\n3 0 1 2\n";
+    expect_one_line_and_nothing_written(
+        run_cli({"ao", (dir / "tiled.ply").string(), "-o", (dir / "out.glb").string(), "--texture", "64"}), dir,
+        "outside [0, 1]");
+    // A texture size out of range.
+    const fs::path in = truck("texture-cli-size");
+    expect_one_line_and_nothing_written(
+        run_cli({"ao", in.string(), "-o", (dir / "out.glb").string(), "--texture", "8"}), dir, "--texture");
+    expect_one_line_and_nothing_written(
+        run_cli({"ao", in.string(), "-o", (dir / "out.glb").string(), "--texture", "100000"}), dir, "--texture");
+}
