@@ -206,6 +206,19 @@ TEST(ViewCliModels, MeshWithoutNormalsGetsThem) {
     EXPECT_GT(luminance_stddev(img), 0.0); // the model shows against the background
 }
 
+TEST(ViewCliModels, FramesAreCountedAndTheLastWritten) {
+    const std::string dir = test::temp_dir("view_frames");
+    const std::string obj = dir + "/tetra.obj", out = dir + "/tetra.png";
+    std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    const auto r = run_cli({"view", obj, "--screenshot", out, "--size", "64x48", "--frames", "3"}, 300);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("3 frames: "), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::exists(out));
+    const auto bad = run_cli({"view", obj, "--screenshot", out, "--frames", "0"});
+    EXPECT_EQ(bad.exit_code, 2) << bad.err;
+    EXPECT_NE(bad.err.find("--frames"), std::string::npos) << bad.err;
+}
+
 void expect_one_line_failure(const test::CliResult& r, const std::string& out, const std::string& needle) {
     EXPECT_EQ(r.exit_code, 1) << r.err;
     EXPECT_EQ(r.err_lines(), 1) << r.err;

@@ -1,6 +1,6 @@
 // skybake view MODEL.glb --screenshot OUT.png|.exr [--size WxH] [--sun-elevation-deg E]
 //                        [--sun-azimuth-deg A] [--altitude-km H] [--model W.json | --preset P]
-//                        [--rule R] [--set key=value ...]
+//                        [--rule R] [--frames N] [--set key=value ...]
 // A model lit by the sky on OpenGL (skybake/viewer.h), rendered headless.
 #include <algorithm>
 #include <cmath>
@@ -22,6 +22,7 @@ struct ViewModelOpts {
     std::string input, screenshot, size = "960x720", rule = "lebedev:2030";
     std::vector<std::string> set;
     double elevation = 30.0, azimuth = 0.0, altitude = 0.0;
+    int frames = 1;
 };
 
 double parse_number(const std::string& key, const std::string& value, double lo, double hi) {
@@ -106,7 +107,14 @@ void run(const ViewModelOpts& o, const CLI::App& sub) {
     const int order = model.has_transfer() ? model.transfer.order : 3;
     ModelRenderer renderer(model, sky, rule, order);
     ModelFrameStats stats;
-    const Image img = renderer.render(st, &stats);
+    Image img = renderer.render(st, &stats);
+    // Further frames of the same view: the mean draw time of a steady frame.
+    double draw = 0.0;
+    for (int i = 1; i < o.frames; ++i) {
+        ModelFrameStats again;
+        img = renderer.render(st, &again);
+        draw += again.draw_seconds;
+    }
     if (auto_exposure) {
         // The 95th percentile luminance (Rec. 709) of the frame maps to 0.6.
         std::vector<float> lum;
@@ -135,6 +143,9 @@ void run(const ViewModelOpts& o, const CLI::App& sub) {
     }
     if (!model.has_transfer() && st.shading != ModelShading::Unshadowed)
         info("{} has no baked transfer: shading unshadowed (bake one with `skybake prt bake`)", o.input);
+    if (o.frames > 1)
+        info("{} frames: {:.2f} ms per frame after the first ({})", o.frames, 1e3 * draw / double(o.frames - 1),
+             renderer.device_description());
     info("drew {} vertices, {} triangles ({} shading, SH order {}{}) in {:.3f} s (sky SH {:.3f} s, sun {:.3f} s) "
          "at exposure {:+.2f} EV; wrote {}",
          stats.vertices, stats.triangles, model_shading_name(stats.shading), stats.sh_order,
@@ -162,6 +173,9 @@ void add_view_model(CLI::App& group) {
         ->capture_default_str();
     group.add_option("--altitude-km", o->altitude, "Observer above the ground, km")
         ->check(real_in(0.0, 1e6, "km"))
+        ->capture_default_str();
+    group.add_option("--frames", o->frames, "Frames to draw (the last is written); prints the mean frame time")
+        ->check(integer_in(1, 100000))
         ->capture_default_str();
     group.add_option("--rule", o->rule, "Sphere rule of the sky's SH projection")->capture_default_str();
     group.add_option("--set", o->set,
