@@ -303,6 +303,20 @@ struct AoPreviewOptions {
     int samples = 2;           // per pixel and axis (2: 4 samples per pixel)
 };
 
+// The camera of the previews (and of `skybake view MODEL`): a pinhole looking
+// at the centre of the mesh's bounding box from (azimuth, elevation), far
+// enough that the bounding sphere fits the frame. The ray through pixel
+// (x + 0.5, y + 0.5) of a width × height image, top row first, is
+// normalize(forward + cx · right + cy · up) with
+// cx = (2 (x + 0.5) / width − 1) · tan_half_fov_y · aspect, cy = (1 − 2 (y + 0.5) / height) · tan_half_fov_y.
+struct PreviewCamera {
+    glm::vec3 eye{0.0f}, forward{0.0f, 0.0f, -1.0f}, right{1.0f, 0.0f, 0.0f}, up{0.0f, 1.0f, 0.0f}; // world space
+    float tan_half_fov_y = 0.0f, aspect = 1.0f;
+    glm::vec3 centre{0.0f}; // of the bounding box
+    float radius = 0.0f;    // of the bounding sphere, world units
+};
+PreviewCamera preview_camera(const Mesh& mesh, const AoPreviewOptions& options);
+
 // Ray-casts the mesh (Embree) from a camera that frames its bounding sphere and
 // shades each visible point by the baked AO, interpolated across the triangle,
 // as a display value: the linear pixel is srgb_to_linear(AO), so that a PNG

@@ -15,6 +15,29 @@
 
 namespace skybake {
 
+PreviewCamera preview_camera(const Mesh& mesh, const AoPreviewOptions& o) {
+    // Camera framing the bounding sphere of the bounding box, y up.
+    const Bounds b = compute_bounds(mesh);
+    PreviewCamera c;
+    c.centre = 0.5f * (b.min + b.max);
+    c.radius = std::max(0.5f * b.diagonal(), 1e-20f);
+    const float deg = 3.14159265358979f / 180.0f;
+    const float az = o.azimuth_deg * deg, el = o.elevation_deg * deg;
+    const glm::vec3 to_eye(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
+    const float half = 0.5f * o.fov_y_deg * deg;
+    c.aspect = float(o.width) / float(o.height);
+    const float fit = std::min(std::sin(half), std::sin(std::atan(std::tan(half) * c.aspect)));
+    c.eye = c.centre + to_eye * (c.radius / fit * 1.02f);
+    c.forward = -to_eye;
+    glm::vec3 up_hint(0.0f, 1.0f, 0.0f);
+    if (std::abs(glm::dot(c.forward, up_hint)) > 0.999f)
+        up_hint = glm::vec3(0.0f, 0.0f, -1.0f);
+    c.right = glm::normalize(glm::cross(c.forward, up_hint));
+    c.up = glm::cross(c.right, c.forward);
+    c.tan_half_fov_y = std::tan(half);
+    return c;
+}
+
 Image bake::render_preview(const Mesh& mesh, const AoPreviewOptions& o, const bake::PreviewShader& shade,
                            const bake::PreviewBackground& sky) {
     if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
@@ -28,24 +51,9 @@ Image bake::render_preview(const Mesh& mesh, const AoPreviewOptions& o, const ba
     const auto backend = make_ray_queries("embree");
     backend->set_mesh(mesh, BackFaces::Occlude);
 
-    // Camera framing the bounding sphere of the bounding box, y up.
-    const Bounds b = compute_bounds(mesh);
-    const glm::vec3 centre = 0.5f * (b.min + b.max);
-    const float radius = std::max(0.5f * b.diagonal(), 1e-20f);
-    const float deg = 3.14159265358979f / 180.0f;
-    const float az = o.azimuth_deg * deg, el = o.elevation_deg * deg;
-    const glm::vec3 to_eye(std::cos(el) * std::sin(az), std::sin(el), std::cos(el) * std::cos(az));
-    const float half = 0.5f * o.fov_y_deg * deg;
-    const float aspect = float(o.width) / float(o.height);
-    const float fit = std::min(std::sin(half), std::sin(std::atan(std::tan(half) * aspect)));
-    const glm::vec3 eye = centre + to_eye * (radius / fit * 1.02f);
-    const glm::vec3 forward = -to_eye;
-    glm::vec3 up_hint(0.0f, 1.0f, 0.0f);
-    if (std::abs(glm::dot(forward, up_hint)) > 0.999f)
-        up_hint = glm::vec3(0.0f, 0.0f, -1.0f);
-    const glm::vec3 right = glm::normalize(glm::cross(forward, up_hint));
-    const glm::vec3 up = glm::cross(right, forward);
-    const float th = std::tan(half);
+    const PreviewCamera cam = preview_camera(mesh, o);
+    const glm::vec3 eye = cam.eye, forward = cam.forward, right = cam.right, up = cam.up;
+    const float th = cam.tan_half_fov_y, aspect = cam.aspect;
 
     const glm::vec3 background(0.035f, 0.045f, 0.065f);
     Image img(o.width, o.height);

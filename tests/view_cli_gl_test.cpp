@@ -1,0 +1,247 @@
+// `skybake view MODEL --screenshot` on the headless EGL context (Mesa
+// llvmpipe is enough): the 2CylinderEngine model (Khronos glTF sample, as
+// Debian's assimp-testmodels ships it), baked with `skybake prt bake`, under
+// the dense paper atmosphere's network at noon, at sunset and at night; the
+// exposure setting; the match with `skybake prt relight` (the C++ twin of
+// the shader: relight() and the ray-cast preview on the same camera); and the
+// models it must handle: no normals, no transfer, a broken file, no OpenGL.
+//
+// Metric of the match: PSNR of the tone-mapped sRGB values (ACES, the
+// exposure relight chose) over the pixels the model covers entirely (equal
+// with the sky background and without it), ≥ 30 dB. The backgrounds differ
+// by design (the network per pixel against relight's SH light).
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.h"
+#include "skybake/image.h"
+
+namespace skybake {
+namespace {
+
+namespace fs = std::filesystem;
+using test::run_cli;
+
+const std::string kNetwork = std::string(SKYBAKE_SOURCE_DIR) + "/tests/data/planet/sky_paper_dense.json";
+
+std::string engine_path() {
+    for (const char* p : {"/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb",
+                          "/usr/share/assimp/models/glTF2/2CylinderEngine/glTF-Binary/2CylinderEngine.glb"})
+        if (fs::exists(p))
+            return p;
+    return {};
+}
+
+class ViewCli : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        const std::string engine = engine_path();
+        if (engine.empty())
+            return;
+        dir_ = test::temp_dir("view_cli");
+        baked_ = dir_ + "/engine.glb";
+        const auto r = run_cli({"prt", "bake", engine, "-o", baked_, "--order", "3", "--rule", "lebedev:194"}, 600);
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+    }
+    void SetUp() override {
+        if (baked_.empty())
+            GTEST_SKIP() << "2CylinderEngine.glb not found (Debian package assimp-testmodels)";
+    }
+    // A linear EXR screenshot.
+    static Image view(const std::string& name, const std::string& elevation, std::vector<std::string> set = {}) {
+        const std::string out = dir_ + "/" + name + ".exr";
+        std::vector<std::string> args = {"view",    baked_,   "--screenshot",        out,      "--size", "160x120",
+                                         "--model", kNetwork, "--sun-elevation-deg", elevation};
+        set.insert(set.begin(), "exposure=0");
+        for (const std::string& s : set)
+            args.insert(args.end(), {"--set", s});
+        const auto r = run_cli(args, 300);
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        return load_image(out);
+    }
+    static inline std::string dir_, baked_;
+};
+
+double mean_luminance(const Image& img) {
+    double sum = 0.0;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            const float* p = img.pixel(x, y);
+            sum += 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+        }
+    return sum / double(img.width * img.height);
+}
+
+double luminance_stddev(const Image& img) {
+    const double mean = mean_luminance(img);
+    double sum = 0.0;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            const float* p = img.pixel(x, y);
+            const double d = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] - mean;
+            sum += d * d;
+        }
+    return std::sqrt(sum / double(img.width * img.height));
+}
+
+// The mean luminance of the model's pixels in an image with one sample per
+// pixel and background=none: every pixel is then the model or exactly the
+// previews' background colour.
+double model_luminance(const Image& img) {
+    double sum = 0.0;
+    int n = 0;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            const float* p = img.pixel(x, y);
+            if (p[0] == 0.035f && p[1] == 0.045f && p[2] == 0.065f)
+                continue;
+            sum += 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+            ++n;
+        }
+    EXPECT_GT(n, img.width * img.height / 10);
+    return sum / std::max(n, 1);
+}
+
+TEST_F(ViewCli, NoonSunsetNight) {
+    const Image noon = view("noon", "60"), sunset = view("sunset", "2"), night = view("night", "-8");
+    const double ln = mean_luminance(noon), ls = mean_luminance(sunset), lt = mean_luminance(night);
+    const double mn = model_luminance(view("noon_bare", "60", {"background=none", "samples=1"})),
+                 ms = model_luminance(view("sunset_bare", "2", {"background=none", "samples=1"}));
+    std::printf("mean luminance: noon %.4g, sunset %.4g, night (sun at -8 deg) %.4g; model alone: noon %.4g, "
+                "sunset %.4g\n",
+                ln, ls, lt, mn, ms);
+    // Not blank: the model stands out from the sky.
+    EXPECT_GT(luminance_stddev(noon), 0.05 * ln);
+    EXPECT_GT(luminance_stddev(sunset), 0.05 * ls);
+    EXPECT_GT(mn, 2.0 * ms);
+    EXPECT_GT(ms, 0.0);
+    // Night: dark, but the twilight sky still lights the scene a little.
+    EXPECT_LT(lt, 0.05 * ln);
+    EXPECT_GT(lt, 0.0);
+}
+
+TEST_F(ViewCli, ExposureOneStopDoublesLinearValues) {
+    const Image a = view("ev0", "30"), b = view("ev1", "30", {"exposure=1"});
+    ASSERT_EQ(a.width, b.width);
+    double worst = 0.0;
+    int lit = 0;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const float p = a.pixel(x, y)[c], q = b.pixel(x, y)[c];
+                if (p > 1e-6f) {
+                    ++lit;
+                    worst = std::max(worst, std::abs(double(q) / double(p) - 2.0));
+                }
+            }
+    EXPECT_GT(lit, a.width * a.height);
+    EXPECT_LT(worst, 1e-3);
+}
+
+TEST_F(ViewCli, SettingsChangeTheImage) {
+    const Image prt = view("prt", "30"), ao = view("ao", "30", {"shading=ao"}),
+                dark = view("dark", "30", {"albedo=0.2", "background=none", "samples=1"}),
+                bright = view("bright", "30", {"albedo=0.8", "background=none", "samples=1"});
+    EXPECT_NE(mean_luminance(prt), mean_luminance(ao));
+    // Albedo scales the model's radiance (4 times the albedo, 4 times the light).
+    const double ratio = model_luminance(bright) / model_luminance(dark);
+    EXPECT_NEAR(ratio, 4.0, 1e-3);
+}
+
+TEST_F(ViewCli, MatchesPrtRelight) {
+    const std::string relit = dir_ + "/relit.exr";
+    auto r = run_cli({"prt", "relight", baked_, "--light", "sky", "--model", kNetwork, "--sun-elevation-deg", "30",
+                      "--size", "160x120", "--view", "35,30", "-o", relit, "--json"},
+                     300);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const float ev = nlohmann::json::parse(r.out)["exposure_ev"].get<float>();
+    const Image ref = load_image(relit);
+    const Image with_sky = view("match_sky", "30", {"view=35,30"});
+    const Image bare = view("match_bare", "30", {"view=35,30", "background=none"});
+    ASSERT_EQ(ref.width, bare.width);
+    ASSERT_EQ(ref.height, bare.height);
+    const ToneMap tm{ev, ToneCurve::Aces};
+    double se = 0.0;
+    std::size_t n = 0;
+    for (int y = 0; y < ref.height; ++y)
+        for (int x = 0; x < ref.width; ++x) {
+            const float *a = with_sky.pixel(x, y), *b = bare.pixel(x, y), *c = ref.pixel(x, y);
+            if (a[0] != b[0] || a[1] != b[1] || a[2] != b[2])
+                continue; // the background shows in this pixel
+            for (int k = 0; k < 3; ++k) {
+                const double d = linear_to_srgb(tone_map_value(b[k], tm)) - linear_to_srgb(tone_map_value(c[k], tm));
+                se += d * d;
+            }
+            ++n;
+        }
+    ASSERT_GT(n, std::size_t(ref.width * ref.height / 10)); // the model fills part of the frame
+    const double psnr = 10.0 * std::log10(1.0 / std::max(se / double(3 * n), 1e-20));
+    std::printf("view vs prt relight: %.2f dB over %zu model pixels\n", psnr, n);
+    EXPECT_GE(psnr, 30.0);
+}
+
+TEST_F(ViewCli, ModelWithoutTransferIsLitUnshadowed) {
+    const std::string out = dir_ + "/raw.png";
+    const auto r = run_cli({"view", engine_path(), "--screenshot", out, "--size", "120x90", "--model", kNetwork}, 300);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("no baked transfer"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("unshadowed shading"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::exists(out));
+}
+
+TEST(ViewCliModels, MeshWithoutNormalsGetsThem) {
+    const std::string dir = test::temp_dir("view_normals");
+    const std::string obj = dir + "/tetra.obj", out = dir + "/tetra.exr";
+    std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    const auto r = run_cli({"view", obj, "--screenshot", out, "--size", "64x48", "--set", "exposure=0"}, 300);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("normals computed"), std::string::npos) << r.err;
+    const Image img = load_image(out);
+    EXPECT_GT(luminance_stddev(img), 0.0); // the model shows against the background
+}
+
+TEST(ViewCliModels, FramesAreCountedAndTheLastWritten) {
+    const std::string dir = test::temp_dir("view_frames");
+    const std::string obj = dir + "/tetra.obj", out = dir + "/tetra.png";
+    std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    const auto r = run_cli({"view", obj, "--screenshot", out, "--size", "64x48", "--frames", "3"}, 300);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("3 frames: "), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::exists(out));
+    const auto bad = run_cli({"view", obj, "--screenshot", out, "--frames", "0"});
+    EXPECT_EQ(bad.exit_code, 2) << bad.err;
+    EXPECT_NE(bad.err.find("--frames"), std::string::npos) << bad.err;
+}
+
+void expect_one_line_failure(const test::CliResult& r, const std::string& out, const std::string& needle) {
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(r.err_lines(), 1) << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(ViewCliModels, BrokenFileIsOneLine) {
+    const std::string dir = test::temp_dir("view_broken");
+    const std::string glb = dir + "/broken.glb", out = dir + "/x.png";
+    std::ofstream(glb) << "glTF this is not a binary glTF file";
+    expect_one_line_failure(run_cli({"view", glb, "--screenshot", out}), out, "broken.glb");
+}
+
+TEST(ViewCliModels, NoEglPlatformIsOneLine) {
+    const std::string dir = test::temp_dir("view_noegl");
+    const std::string obj = dir + "/tetra.obj", out = dir + "/x.png";
+    std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    setenv("SKYBAKE_EGL_PLATFORM", "none", 1);
+    const auto r = run_cli({"view", obj, "--screenshot", out});
+    unsetenv("SKYBAKE_EGL_PLATFORM");
+    expect_one_line_failure(r, out, "no headless OpenGL");
+}
+
+} // namespace
+} // namespace skybake
