@@ -1,5 +1,6 @@
 # Ambient occlusion: per-vertex AO, shading coefficient A and bent normals
-# (seed 002), baked with Embree (and CUDA where there is a GPU), written as glTF (any viewer shows COLOR_0 = AO)
+# (seed 002), baked with Embree (and CUDA where there is a GPU, and the depth
+# buffer of OpenGL), written as glTF (any viewer shows COLOR_0 = AO)
 # with PNG previews.
 set -euo pipefail
 models=/usr/share/assimp/models
@@ -32,3 +33,12 @@ if "$SKYBAKE" --version | grep -q 'device(s)'; then
 else
   expect_refusal "$SKYBAKE" ao "$OUT/bowl.glb" -o "$OUT/nothing.glb" --device cuda
 fi
+
+# The seed's depth-buffer method: a depth cube map at each vertex, on any
+# OpenGL 4.3 context (Mesa's llvmpipe without a GPU), and one depth map per
+# direction; both against the Embree bake of the same city.
+"$SKYBAKE" mesh generate --kind city --triangles 1000 --seed 1 -o "$OUT/ao_city_small.glb"
+"$SKYBAKE" ao "$OUT/ao_city_small.glb" -o "$OUT/ao_city_small_embree.glb" --rule lebedev:590
+"$SKYBAKE" ao "$OUT/ao_city_small.glb" -o "$OUT/ao_city_small_cube.glb" --rule lebedev:590 --backend raster
+"$SKYBAKE" ao "$OUT/ao_city_small.glb" -o "$OUT/ao_city_small_directional.glb" --rule lebedev:590 \
+  --backend raster --method directional --preview "$OUT/ao_city_small_directional.png" --preview-size 640x480
