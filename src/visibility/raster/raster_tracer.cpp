@@ -363,6 +363,36 @@ void RasterTracer::trace(const TraceChunk& chunk) {
     });
 }
 
+// The compute pass of both methods: the depth layers just drawn become the
+// "blocked" words of pass.count vertices (raster_visibility.glsl, stage CS).
+void RasterTracer::run_bits(const BitsPass& pass) {
+    const State& s = *s_;
+    const TraceRule& rule = s.rule;
+    const GLuint p = s.bits.get();
+    glUseProgram(p);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D_ARRAY, s.depth.get());
+    glUniform1i(uniform(p, "u_depth"), 0);
+    glUniform1i(uniform(p, "u_count"), GLint(pass.count));
+    glUniform1i(uniform(p, "u_first"), GLint(pass.first));
+    glUniform1i(uniform(p, "u_words_per_vertex"), GLint(rule.words_per_vertex));
+    glUniform1i(uniform(p, "u_first_word"), GLint(pass.first_word));
+    glUniform1i(uniform(p, "u_word_count"), GLint(pass.word_count));
+    glUniform1i(uniform(p, "u_first_point"), GLint(pass.first_point));
+    glUniform1i(uniform(p, "u_last_point"), GLint(pass.last_point));
+    glUniform1i(uniform(p, "u_rotate"), rule.rotate ? 1 : 0);
+    glUniform1i(uniform(p, "u_resolution"), GLint(resolution_));
+    glUniform1f(uniform(p, "u_far"), pass.far);
+    glUniform1f(uniform(p, "u_t_max"), std::isfinite(rule.t_max) ? rule.t_max : 3.0e38f);
+    glUniform1f(uniform(p, "u_texel"), pass.texel);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.views.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.point_buffer.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s.vertex_buffer.get());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s.word_buffer.get());
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT); // a word may take a second batch of directions
+    dispatch(std::uint64_t(pass.count) * pass.word_count);
+}
+
 void RasterTracer::trace_cube(const TraceChunk& chunk) {
     State& s = *s_;
     const TraceRule& rule = s.rule;
@@ -374,8 +404,7 @@ void RasterTracer::trace_cube(const TraceChunk& chunk) {
     std::vector<glm::mat4> views(std::size_t(s.batch) * kFaces);
     std::vector<glm::vec4> eyes(views.size());
     std::vector<GpuVertex> vertices(s.batch);
-    const GLint cs_count = uniform(s.bits.get(), "u_count"), cs_first = uniform(s.bits.get(), "u_first");
-    const GLint fs_far = uniform(s.draw.get(), "u_far"), cs_far = uniform(s.bits.get(), "u_far");
+    const GLint fs_far = uniform(s.draw.get(), "u_far");
     for (std::uint32_t first = 0; first < chunk.count; first += s.batch) {
         check_interrupted();
         const std::uint32_t count = std::min(s.batch, chunk.count - first);
@@ -425,26 +454,15 @@ void RasterTracer::trace_cube(const TraceChunk& chunk) {
         glUniform1f(fs_far, far);
         glDrawElementsInstanced(GL_TRIANGLES, s.index_count, GL_UNSIGNED_INT, nullptr, GLsizei(count * kFaces));
 
-        glUseProgram(s.bits.get());
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D_ARRAY, s.depth.get());
-        glUniform1i(uniform(s.bits.get(), "u_depth"), 0);
-        glUniform1i(cs_count, GLint(count));
-        glUniform1i(cs_first, GLint(first));
-        glUniform1i(uniform(s.bits.get(), "u_words_per_vertex"), GLint(wpv));
-        glUniform1i(uniform(s.bits.get(), "u_first_word"), 0);
-        glUniform1i(uniform(s.bits.get(), "u_word_count"), GLint(wpv));
-        glUniform1i(uniform(s.bits.get(), "u_first_point"), 0);
-        glUniform1i(uniform(s.bits.get(), "u_last_point"), GLint(rule.points.size()));
-        glUniform1i(uniform(s.bits.get(), "u_rotate"), rule.rotate ? 1 : 0);
-        glUniform1i(uniform(s.bits.get(), "u_resolution"), GLint(resolution_));
-        glUniform1f(cs_far, far);
-        glUniform1f(uniform(s.bits.get(), "u_t_max"), std::isfinite(rule.t_max) ? rule.t_max : 3.0e38f);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.views.get());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.point_buffer.get());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s.vertex_buffer.get());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s.word_buffer.get());
-        dispatch(std::uint64_t(count) * wpv);
+        BitsPass pass;
+        pass.count = count;
+        pass.first = first;
+        pass.first_word = 0;
+        pass.word_count = wpv;
+        pass.first_point = 0;
+        pass.last_point = std::uint32_t(rule.points.size());
+        pass.far = far;
+        run_bits(pass);
         gl::check_gl("raster backend cube pass");
     }
 }
@@ -452,7 +470,6 @@ void RasterTracer::trace_cube(const TraceChunk& chunk) {
 void RasterTracer::trace_directional(const TraceChunk& chunk) {
     State& s = *s_;
     const TraceRule& rule = s.rule;
-    const std::uint32_t wpv = rule.words_per_vertex;
     const auto k = std::uint32_t(rule.points.size());
     if (chunk.count > s.vertex_capacity) {
         s.vertex_buffer = storage_buffer(chunk.count * sizeof(GpuVertex));
@@ -496,29 +513,16 @@ void RasterTracer::trace_directional(const TraceChunk& chunk) {
                    s.vs_layer && s.back_faces == BackFaces::Ignore ? GL_FRONT : GL_NONE);
         glDrawElementsInstanced(GL_TRIANGLES, s.index_count, GL_UNSIGNED_INT, nullptr, GLsizei(j1 - j0));
 
-        const GLuint p = s.bits.get();
-        glUseProgram(p);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D_ARRAY, s.depth.get());
-        glUniform1i(uniform(p, "u_depth"), 0);
-        const std::uint32_t w0 = j0 / 32, w1 = (j1 + 31) / 32;
-        glUniform1i(uniform(p, "u_count"), GLint(chunk.count));
-        glUniform1i(uniform(p, "u_first"), 0);
-        glUniform1i(uniform(p, "u_words_per_vertex"), GLint(wpv));
-        glUniform1i(uniform(p, "u_first_word"), GLint(w0));
-        glUniform1i(uniform(p, "u_word_count"), GLint(w1 - w0));
-        glUniform1i(uniform(p, "u_first_point"), GLint(j0));
-        glUniform1i(uniform(p, "u_last_point"), GLint(j1));
-        glUniform1i(uniform(p, "u_rotate"), 0);
-        glUniform1i(uniform(p, "u_resolution"), GLint(resolution_));
-        glUniform1f(uniform(p, "u_far"), range);
-        glUniform1f(uniform(p, "u_texel"), texel);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.views.get());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.point_buffer.get());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s.vertex_buffer.get());
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s.word_buffer.get());
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT); // the previous batch's words are read back in
-        dispatch(std::uint64_t(chunk.count) * (w1 - w0));
+        BitsPass pass;
+        pass.count = chunk.count;
+        pass.first = 0;
+        pass.first_word = j0 / 32;
+        pass.word_count = (j1 + 31) / 32 - pass.first_word;
+        pass.first_point = j0;
+        pass.last_point = j1;
+        pass.far = range;
+        pass.texel = texel;
+        run_bits(pass);
         gl::check_gl("raster backend directional pass");
     }
 }

@@ -44,7 +44,16 @@ public:
 
 private:
     struct State;
+    // One dispatch of the compute pass (raster_tracer.cpp).
+    struct BitsPass {
+        std::uint32_t count = 0, first = 0;            // vertices, and the first one's slot in the chunk
+        std::uint32_t first_word = 0, word_count = 0;  // the words written
+        std::uint32_t first_point = 0, last_point = 0; // the directions drawn, [first, last)
+        float far = 0.0f;                              // cube: depth scale; directional: depth range
+        float texel = 0.0f;                            // directional: texel size (the normal offset)
+    };
     void build_programs();
+    void run_bits(const BitsPass& pass);
     void trace_cube(const TraceChunk& chunk);
     void trace_directional(const TraceChunk& chunk);
 
