@@ -1,0 +1,108 @@
+// skybake.bake_ao: per-vertex ambient occlusion, shading coefficient, bent
+// normals and visibility bits on any backend (skybake/bake.h).
+#include <cmath>
+#include <limits>
+#include <optional>
+
+#include "common.h"
+#include "skybake/bake.h"
+#include "skybake/mesh.h"
+#include "skybake/sphere.h"
+#include "skybake/visibility.h"
+
+namespace skybake::python {
+
+namespace {
+
+struct BakeResult {
+    py::object ao, shading, bent_normal, bits;
+    AoBakeReport report;
+    std::uint32_t words_per_vertex = 0;
+};
+
+} // namespace
+
+// The tracer for a backend name and an optional method ("" or None: its
+// default). Shared with the PRT bindings.
+std::unique_ptr<VisibilityTracer> make_tracer(const std::string& backend, const std::optional<std::string>& method,
+                                              std::uint32_t resolution, TraceMethod* chosen) {
+    const TraceMethod m = method && !method->empty() ? parse_trace_method(*method) : default_trace_method(backend);
+    if (chosen)
+        *chosen = m;
+    return make_visibility_tracer(backend, m, resolution);
+}
+
+BakeOptions bake_options(float max_distance, float offset, const std::string& back_faces, bool normalize) {
+    BakeOptions b;
+    if (!(max_distance > 0.0f))
+        throw Error("must be > 0 (inf: unlimited)", "max_distance");
+    if (!(offset >= 0.0f) || !std::isfinite(offset))
+        throw Error("must be a finite value ≥ 0", "offset");
+    b.max_distance = max_distance;
+    b.ray_offset = offset;
+    b.back_faces = parse_back_faces(back_faces);
+    b.normalize = normalize;
+    return b;
+}
+
+void bind_bake(py::module_& m) {
+    py::class_<BakeResult>(m, "BakeResult", "What bake_ao() computed, one entry per vertex.")
+        .def_readonly("ao", &BakeResult::ao, "(N,) float32: ambient occlusion (cosine-weighted visibility).")
+        .def_readonly("shading", &BakeResult::shading, "(N,) float32: the shading coefficient A.")
+        .def_readonly("bent_normal", &BakeResult::bent_normal, "(N, 3) float32, unit.")
+        .def_readonly("bits", &BakeResult::bits,
+                      "(N, W) uint32 visibility words (bit k % 32 of word k / 32: direction k visible), or None "
+                      "without store_bits.")
+        .def_property_readonly("backend", [](const BakeResult& r) { return r.report.backend; })
+        .def_property_readonly("method", [](const BakeResult& r) { return r.report.method; })
+        .def_property_readonly("rule", [](const BakeResult& r) { return r.report.rule; })
+        .def_property_readonly("directions", [](const BakeResult& r) { return r.report.directions; })
+        .def_property_readonly("rays", [](const BakeResult& r) { return r.report.rays; })
+        .def_property_readonly("seconds", [](const BakeResult& r) { return r.report.seconds; })
+        .def_property_readonly("build_seconds", [](const BakeResult& r) { return r.report.build_seconds; })
+        .def_property_readonly("trace_seconds", [](const BakeResult& r) { return r.report.trace_seconds; })
+        .def_property_readonly("ray_offset", [](const BakeResult& r) { return r.report.ray_offset; })
+        .def_property_readonly("clamped_vertices", [](const BakeResult& r) { return r.report.clamped_vertices; })
+        .def("__repr__", [](const BakeResult& r) {
+            return "BakeResult(backend='" + r.report.backend + "', rule='" + r.report.rule +
+                   "', vertices=" + std::to_string(r.report.vertices) + ", rays=" + std::to_string(r.report.rays) +
+                   ")";
+        });
+
+    m.def(
+        "bake_ao",
+        [](Mesh& mesh, const std::string& rule_spec, const std::string& backend, std::optional<std::string> method,
+           std::uint32_t resolution, float max_distance, float offset, const std::string& back_faces, bool normalize,
+           bool store_bits, py::object progress) {
+            const SphereRule rule = parse_rule(rule_spec);
+            BakeOptions b = bake_options(max_distance, offset, back_faces, normalize);
+            b.store_bits = store_bits;
+            BakeOutputs out;
+            AoBakeReport report = long_call(std::move(progress), [&] {
+                const auto tracer = make_tracer(backend, method, resolution, &b.method);
+                return bake_ambient_occlusion(mesh, rule, *tracer, b, &out);
+            });
+            BakeResult r;
+            const auto n = py::ssize_t(mesh.vertex_count());
+            r.ao = to_numpy(std::move(out.ao), {n});
+            r.shading = to_numpy(std::move(out.shading), {n});
+            r.bent_normal = to_numpy(std::move(out.bent_normal));
+            r.words_per_vertex = out.words_per_vertex;
+            r.bits = store_bits ? py::object(to_numpy(std::move(out.visibility_bits), {n, py::ssize_t(out.words_per_vertex)}))
+                                : py::object(py::none());
+            r.report = std::move(report);
+            return r;
+        },
+        py::arg("mesh"), py::arg("rule") = "lebedev:590", py::arg("backend") = "embree",
+        py::arg("method") = py::none(), py::arg("resolution") = 0u,
+        py::arg("max_distance") = std::numeric_limits<float>::infinity(), py::arg("offset") = 0.0f,
+        py::arg("back_faces") = "occlude", py::arg("normalize") = false, py::arg("store_bits") = false,
+        py::arg("progress") = py::none(),
+        "Bakes AO, the shading coefficient and bent normals at every vertex, as `skybake ao` does, and also "
+        "stores them on the mesh (attributes 'ao', 'shading', 'bent_normal'; colours (AO, AO, AO, 1)); "
+        "normals are computed first when the mesh has none. backend: 'embree', 'brute', 'cuda' or 'raster' "
+        "(method 'cube' or 'directional', resolution in texels; 0: the default). The GIL is released; "
+        "progress(event) is called at most every 100 ms; Ctrl-C or an exception it raises stops the bake.");
+}
+
+} // namespace skybake::python

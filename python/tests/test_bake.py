@@ -1,0 +1,182 @@
+"""Bakes through Python: closed forms, the CLI on the same mesh, the bits,
+progress, the GIL and Ctrl-C."""
+import os
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import skybake
+
+
+def test_bowl_ao_is_one_half(bowl):
+    # Any point inside a hemispherical bowl sees the opening as half its
+    # cosine-weighted hemisphere (the sphere's form factor is the area ratio).
+    m = bowl.copy()
+    r = skybake.bake_ao(m, rule="lebedev:5810")
+    y = m.positions[:, 1]
+    inner = y < -0.2  # away from the rim, whose vertices see past it
+    assert inner.sum() > 100
+    assert np.max(np.abs(r.ao[inner] - 0.5)) < 0.02
+    assert abs(np.median(r.ao[inner]) - 0.5) < 5e-3
+
+
+def test_convex_mesh_sees_everything(sphere):
+    m = sphere.copy()
+    r = skybake.bake_ao(m, rule="lebedev:590")
+    assert r.ao.shape == (m.vertex_count,) and r.ao.dtype == np.float32
+    assert np.min(r.ao) > 0.998 and np.min(r.shading) > 0.998  # the rule's error for the clamped cosine
+    n = skybake.bake_ao(m.copy(), rule="lebedev:590", normalize=True)
+    assert np.min(n.ao) > 1 - 1e-6 and np.min(n.shading) > 1 - 1e-6
+    # The bent normal of an unoccluded vertex is its normal.
+    dots = np.einsum("ij,ij->i", r.bent_normal, m.normals)
+    assert np.min(dots) > 0.9999
+
+
+def test_results_are_stored_on_the_mesh(bowl):
+    m = bowl.copy()
+    r = skybake.bake_ao(m)
+    np.testing.assert_array_equal(m.attribute("ao"), r.ao)
+    np.testing.assert_array_equal(m.attribute("shading"), r.shading)
+    np.testing.assert_array_equal(m.attribute("bent_normal"), r.bent_normal)
+    np.testing.assert_array_equal(m.colors[:, 0], r.ao)
+
+
+@pytest.mark.parametrize("options", [{}, {"max_distance": 0.3, "back_faces": "ignore", "offset": 0.001}])
+def test_same_as_the_cli(cli, tmp, options):
+    m = skybake.generate_mesh("city", 4000, seed=3)
+    m.compute_normals()
+    src = tmp / "city.ply"
+    skybake.save_mesh(src, m)
+    r = skybake.bake_ao(m, rule="lebedev:230", **options)
+    flags = []
+    if "max_distance" in options:
+        flags += ["--max-distance", options["max_distance"], "--back-faces", options["back_faces"],
+                  "--offset", options["offset"]]
+    cli("ao", src, "-o", tmp / "out.ply", "--rule", "lebedev:230", "--quiet", *flags)
+    out = skybake.load_mesh(tmp / "out.ply")
+    assert np.max(np.abs(out.attribute("ao") - r.ao)) <= 1e-6
+    assert np.max(np.abs(out.attribute("shading") - r.shading)) <= 1e-6
+    assert np.max(np.abs(out.attribute("bent_normal") - r.bent_normal)) <= 1e-6
+
+
+def test_bits_reproduce_the_ao(bowl):
+    m = bowl.copy()
+    rule = skybake.Rule("lebedev:590")
+    r = skybake.bake_ao(m, rule=rule.spec, store_bits=True)
+    assert r.bits.dtype == np.uint32 and r.bits.shape == (m.vertex_count, (len(rule) + 31) // 32)
+    k = np.arange(len(rule))
+    visible = (r.bits[:, k // 32] >> (k % 32).astype(np.uint32)) & 1
+    cos = np.clip(m.normals.astype(np.float64) @ rule.points.T, 0, None)
+    ao = np.clip((visible * cos * 4 * rule.weights).sum(axis=1), 0, 1)
+    assert np.max(np.abs(ao - r.ao)) < 1e-5
+
+
+def test_brute_force_agrees_with_embree():
+    m = skybake.generate_mesh("wall", 800)
+    a = skybake.bake_ao(m.copy(), rule="lebedev:230", backend="embree", store_bits=True)
+    b = skybake.bake_ao(m.copy(), rule="lebedev:230", backend="brute", store_bits=True)
+    same = np.mean(a.bits == b.bits)
+    assert same > 0.99
+    assert np.max(np.abs(a.ao - b.ao)) < 0.05
+
+
+def test_backends_and_bad_options(bowl):
+    names = [b.name for b in skybake.backends()]
+    assert {"embree", "brute", "raster"} <= set(names)
+    assert all(b.available or b.problem for b in skybake.backends())
+    with pytest.raises(skybake.Error) as info:
+        skybake.bake_ao(bowl.copy(), backend="optix")
+    assert info.value.where == "backend"
+    with pytest.raises(skybake.Error) as info:
+        skybake.bake_ao(bowl.copy(), max_distance=-1)
+    assert info.value.where == "max_distance"
+    with pytest.raises(skybake.Error):
+        skybake.bake_ao(bowl.copy(), rule="nope:1")
+    with pytest.raises(skybake.Error) as info:
+        skybake.bake_ao(bowl.copy(), backend="embree", method="cube")
+    assert info.value.where == "method"
+
+
+def test_empty_mesh_is_an_error():
+    with pytest.raises(skybake.Error, match="no triangles"):
+        skybake.Mesh(np.zeros((0, 3), np.float32), np.zeros((0, 3), np.uint32))
+    m = skybake.generate_mesh("sphere", 200)
+    m.indices = np.zeros((0, 3), np.uint32)  # emptied after construction
+    with pytest.raises(skybake.Error, match="no triangles"):
+        skybake.bake_ao(m)
+
+
+def test_progress_callback_sees_the_end(bowl):
+    events = []
+    skybake.bake_ao(bowl.copy(), rule="lebedev:590", progress=events.append)
+    assert events and events[-1].finished and events[-1].label == "bake"
+    assert events[-1].done == events[-1].total == bowl.vertex_count
+    assert all(0.0 <= e.fraction <= 1.0 for e in events)
+
+
+def big_bake():
+    return skybake.generate_mesh("city", 20000, seed=2), "lebedev:2030"
+
+
+def test_an_exception_in_the_callback_stops_the_bake():
+    m, rule = big_bake()
+
+    class Stop(Exception):
+        pass
+
+    calls = []
+
+    def progress(e):
+        calls.append(e.done)
+        raise Stop("enough")
+
+    t0 = time.perf_counter()
+    with pytest.raises(Stop, match="enough"):
+        skybake.bake_ao(m, rule=rule, progress=progress)
+    assert len(calls) == 1
+    assert "ao" not in m.attribute_names  # nothing stored
+    with pytest.raises(skybake.Error, match="callable"):
+        skybake.bake_ao(m, progress=42)
+    assert time.perf_counter() - t0 < 60
+
+
+def test_the_gil_is_released_during_a_bake():
+    m, rule = big_bake()
+    ticks = [0]
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            ticks[0] += 1
+            time.sleep(0.001)
+
+    t = threading.Thread(target=count)
+    t.start()
+    time.sleep(0.05)
+    before = ticks[0]
+    t0 = time.perf_counter()
+    skybake.bake_ao(m, rule=rule)
+    seconds = time.perf_counter() - t0
+    during = ticks[0] - before
+    stop.set()
+    t.join()
+    assert seconds > 0.2, "the bake is too short to tell"
+    # Holding the GIL would let the counter tick at most a few times.
+    assert during >= 0.2 * seconds / 0.0012, (during, seconds)
+
+
+def test_ctrl_c_raises_keyboard_interrupt():
+    m, rule = big_bake()
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    t0 = time.perf_counter()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        skybake.bake_ao(m, rule=rule)
+        time.sleep(5)  # a bake that finished first: the signal arrives here
+    timer.join()
+    assert time.perf_counter() - t0 < 30
+    # Python's handler is back: the next call runs normally.
+    skybake.bake_ao(skybake.generate_mesh("sphere", 200))
