@@ -22,8 +22,10 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev glslang-tools
   # OpenGL (headless EGL and windowed GLFW)
   libegl-dev libgl-dev libglfw3-dev libepoxy-dev libegl-mesa0 libgl1-mesa-dri
-  # Python bindings
-  pybind11-dev python3-dev
+  # Python module, its tests, and the Blender add-on's
+  pybind11-dev python3-dev python3-numpy python3-pytest blender
+  # tests of real windows
+  xvfb xauth
 )
 
 missing=()

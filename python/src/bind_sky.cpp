@@ -86,9 +86,11 @@ void bind_sky(py::module_& m) {
         [](const std::string& name, double r, double mie) { return atmosphere_preset(name, r, mie); },
         py::arg("name"), py::arg("paper_r") = 10000.0, py::arg("paper_m") = 10000.0,
         "'earth', 'paper' (the seed's r = m = 10000, or paper_r, paper_m) or 'paper-dense'.");
-    m.def("atmosphere_presets", &atmosphere_preset_names);
-    m.def("load_atmosphere", &load_atmosphere, py::arg("path"));
-    m.def("save_atmosphere", &save_atmosphere, py::arg("path"), py::arg("atmosphere"));
+    m.def("atmosphere_presets", &atmosphere_preset_names, "The names atmosphere_preset() takes.");
+    m.def("load_atmosphere", &load_atmosphere, py::arg("path"),
+          "Reads an atmosphere JSON file; raises skybake.Error naming the bad field.");
+    m.def("save_atmosphere", &save_atmosphere, py::arg("path"), py::arg("atmosphere"),
+          "Writes an atmosphere JSON file. Atomic.");
 
     py::class_<NeuralSky>(m, "NeuralSky", "A trained sky network: its topology, weights and atmosphere.")
         .def_property_readonly("topology", [](const NeuralSky& n) { return n.topology.name(); })
