@@ -222,6 +222,18 @@ def bake_ao(
 ) -> BakeResult:
     """AO, shading coefficient and bent normals per vertex, also stored on the mesh. GIL released."""
 
+def render_preview(
+    mesh: Mesh,
+    values: F32,
+    width: int = 960,
+    height: int = 720,
+    azimuth_deg: float = 35.0,
+    elevation_deg: float = 30.0,
+    fov_deg: float = 35.0,
+    samples: int = 2,
+) -> F32:
+    """The mesh shaded by per-vertex values, (N,) or (N, 3) float32: linear (H, W, 3) float32."""
+
 # --- precomputed radiance transfer ----------------------------------------------------
 
 class Transfer:

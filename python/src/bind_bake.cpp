@@ -103,6 +103,49 @@ void bind_bake(py::module_& m) {
         "normals are computed first when the mesh has none. backend: 'embree', 'brute', 'cuda' or 'raster' "
         "(method 'cube' or 'directional', resolution in texels; 0: the default). The GIL is released; "
         "progress(event) is called at most every 100 ms; Ctrl-C or an exception it raises stops the bake.");
+
+    m.def(
+        "render_preview",
+        [](const Mesh& mesh, const py::handle& values, int width, int height, float azimuth_deg, float elevation_deg,
+           float fov_deg, int samples) {
+            validate_mesh(mesh, "mesh");
+            if (!py::isinstance<py::array>(values))
+                throw Error("expected a NumPy array of float32", "values");
+            const auto n = py::ssize_t(mesh.vertex_count());
+            std::vector<glm::vec3> rgb;
+            if (py::reinterpret_borrow<py::array>(values).ndim() == 1) {
+                const auto v = checked_array<float>(values, "values", {n}, true);
+                rgb.resize(std::size_t(n));
+                for (py::ssize_t i = 0; i < n; ++i)
+                    rgb[std::size_t(i)] = glm::vec3(v.data()[i]);
+            } else {
+                rgb = vec3_vector(checked_array<float>(values, "values", {n, 3}, true));
+            }
+            if (width < 1 || height < 1 || width > 16384 || height > 16384)
+                throw Error("width and height must be in 1..16384", "width");
+            if (samples < 1 || samples > 8)
+                throw Error("must be in 1..8", "samples");
+            AoPreviewOptions o;
+            o.width = width;
+            o.height = height;
+            o.azimuth_deg = azimuth_deg;
+            o.elevation_deg = elevation_deg;
+            o.fov_y_deg = fov_deg;
+            o.samples = samples;
+            Image img;
+            {
+                py::gil_scoped_release release;
+                img = render_vertex_preview(mesh, rgb, o);
+            }
+            return image_to_numpy(std::move(img));
+        },
+        py::arg("mesh"), py::arg("values"), py::arg("width") = 960, py::arg("height") = 720,
+        py::arg("azimuth_deg") = 35.0f, py::arg("elevation_deg") = 30.0f, py::arg("fov_deg") = 35.0f,
+        py::arg("samples") = 2,
+        "Ray-casts the mesh from the previews' camera (framing its bounding sphere from azimuth, elevation) and "
+        "shades it by per-vertex values, (N,) grey or (N, 3) linear RGB float32, interpolated: a linear "
+        "(H, W, 3) float32 image. For AO as a display value, pass values = srgb_to_linear(ao) and save with "
+        "tone='clamp'.");
 }
 
 } // namespace skybake::python

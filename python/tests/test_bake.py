@@ -180,3 +180,16 @@ def test_ctrl_c_raises_keyboard_interrupt():
     assert time.perf_counter() - t0 < 30
     # Python's handler is back: the next call runs normally.
     skybake.bake_ao(skybake.generate_mesh("sphere", 200))
+
+
+def test_preview_shows_the_values(bowl):
+    m = bowl.copy()
+    img = skybake.render_preview(m, np.full(m.vertex_count, 0.5, np.float32), width=64, height=48, samples=1)
+    assert img.shape == (48, 64, 3)
+    covered = np.all(np.abs(img - 0.5) < 1e-6, axis=2)
+    assert 0.1 < covered.mean() < 0.9  # the bowl, and the background around it
+    red = skybake.render_preview(m, np.tile(np.array([1, 0, 0], np.float32), (m.vertex_count, 1)), 64, 48, samples=1)
+    np.testing.assert_allclose(red[covered], np.tile([1.0, 0.0, 0.0], (covered.sum(), 1)), atol=1e-6)
+    with pytest.raises(skybake.Error) as info:
+        skybake.render_preview(m, np.zeros(3, np.float32))
+    assert info.value.where == "values"
