@@ -164,8 +164,9 @@ def test_the_gil_is_released_during_a_bake():
     stop.set()
     t.join()
     assert seconds > 0.2, "the bake is too short to tell"
-    # Holding the GIL would let the counter tick at most a few times.
-    assert during >= 0.2 * seconds / 0.0012, (during, seconds)
+    # Holding the GIL for the bake would stop the counter (0 or 1 tick);
+    # released, it ticks every millisecond or so, fewer on a loaded machine.
+    assert during >= 10, (during, seconds)
 
 
 def test_ctrl_c_raises_keyboard_interrupt():
