@@ -194,3 +194,16 @@ def test_preview_shows_the_values(bowl):
     with pytest.raises(skybake.Error) as info:
         skybake.render_preview(m, np.zeros(3, np.float32))
     assert info.value.where == "values"
+
+
+def test_raster_backend_bakes_the_bowl(bowl):
+    raster = [b for b in skybake.backends() if b.name == "raster"][0]
+    if not raster.available:
+        pytest.skip("no headless OpenGL: " + raster.problem)
+    m = bowl.copy()
+    r = skybake.bake_ao(m, rule="lebedev:590", backend="raster", resolution=128)
+    assert r.backend == "raster" and r.method == "cube"
+    inner = m.positions[:, 1] < -0.2
+    assert abs(np.median(r.ao[inner]) - 0.5) < 0.01
+    e = skybake.bake_ao(bowl.copy(), rule="lebedev:590")
+    assert np.mean(np.abs(r.ao - e.ao)) < 0.01
