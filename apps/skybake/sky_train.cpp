@@ -18,7 +18,7 @@ void add_sky_train(CLI::App& group) {
         NeuralTrainOptions t;
         std::string topology = "paper", brightness = "log", output, curve, chart, device = "cpu";
         double log_range_decades = 6.0;
-        int steps = 16;
+        int steps = kTrainingTargetSteps;
         bool json = false;
     };
     auto o = std::make_shared<Opts>();
@@ -75,7 +75,11 @@ void add_sky_train(CLI::App& group) {
         o->t.device = parse_flag("--device", [&] { return parse_device(o->device); });
         if (o->t.device == Device::Cuda)
             require_cuda_device("--device cuda");
-        const Atmosphere atm = o->atm.load(*sub);
+        Atmosphere atm = o->atm.load(*sub);
+        // Targets good enough to learn from: the refined shell rule unless
+        // --table-rule says otherwise (docs/neural.md, "Training targets").
+        if (!given(*sub, "--table-rule"))
+            atm.table_rule = TableRule::Refined;
         o->t.topology = parse_flag("--topology", [&] { return parse_topology(o->topology); });
         o->t.brightness = parse_flag("--brightness", [&] { return parse_brightness_encoding(o->brightness); });
         o->t.log_range = o->log_range_decades * std::log(10.0);

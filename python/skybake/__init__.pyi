@@ -185,6 +185,8 @@ def train_sky(
     lm_iterations: int = 30,
     seed: int = 1,
     brightness: str = "log",
+    table_rule: str = "refined",
+    steps: int = 64,
     device: str = "cpu",
     progress: Progress = None,
 ) -> NeuralSky: ...

@@ -216,10 +216,13 @@ void bind_sky(py::module_& m) {
 
     m.def(
         "train_sky",
-        [](const Atmosphere& atmosphere, const std::string& topology, std::size_t samples, int adam_epochs,
-           int lm_iterations, std::uint64_t seed, const std::string& brightness, const std::string& device,
-           py::object progress) {
+        [](Atmosphere atmosphere, const std::string& topology, std::size_t samples, int adam_epochs,
+           int lm_iterations, std::uint64_t seed, const std::string& brightness, const std::string& table_rule,
+           int steps, const std::string& device, py::object progress) {
+            atmosphere.table_rule = parse_table_rule(table_rule, "table_rule");
             atmosphere.validate();
+            if (steps < 1 || steps > 4096)
+                throw Error("must be in 1..4096", "steps");
             NeuralTrainOptions o;
             o.topology = parse_topology(topology, "topology");
             o.samples = samples;
@@ -234,16 +237,21 @@ void bind_sky(py::module_& m) {
                 throw Error("at least 1000 training samples, got " + std::to_string(samples), "samples");
             if (adam_epochs < 0 || lm_iterations < 0)
                 throw Error("epochs and iterations must be ≥ 0", "adam_epochs");
+            SkyModelOptions targets;
+            targets.steps = steps;
             return long_call(std::move(progress), [&] {
-                const SkyModel model(atmosphere);
+                const SkyModel model(atmosphere, targets);
                 return train_neural_sky(model, o);
             });
         },
         py::arg("atmosphere"), py::arg("topology") = "paper", py::arg("samples") = 800000,
         py::arg("adam_epochs") = 60, py::arg("lm_iterations") = 30, py::arg("seed") = 1,
-        py::arg("brightness") = "log", py::arg("device") = "cpu", py::arg("progress") = py::none(),
-        "Trains a network on the reference model of `atmosphere` (Adam, then Levenberg–Marquardt). "
-        "Deterministic for a seed. topology: 'paper' (324 weights), 'independent:16x16', 'shared:64x64', ...");
+        py::arg("brightness") = "log", py::arg("table_rule") = "refined", py::arg("steps") = kTrainingTargetSteps,
+        py::arg("device") = "cpu", py::arg("progress") = py::none(),
+        "Trains a network on the table path of `atmosphere` (Adam, then Levenberg–Marquardt), as "
+        "`skybake sky train`: targets from the refined tables with 64 steps by default (table_rule="
+        "'as-published', steps=16, brightness='linear' for the seed's setting). Deterministic for a seed. "
+        "topology: 'paper' (324 weights), 'independent:16x16', 'shared:64x64', ...");
 }
 
 } // namespace skybake::python
