@@ -91,6 +91,7 @@ void add_sky_train(CLI::App& group) {
                              "--batch");
         SkyModelOptions opts;
         opts.steps = o->steps;
+        opts.tables = kTrainingTargetTables;
         const SkyModel model(atm, opts);
         std::vector<LearningCurvePoint> curve;
         const NeuralSky net = train_neural_sky(model, o->t, &curve);

@@ -167,11 +167,13 @@ void neural_sky_encoded(const NeuralSky& net, const SkySample& sample, float enc
 // then Levenberg–Marquardt on each sub-network. Deterministic for a given
 // seed, whatever the thread count.
 // The targets `skybake sky train` and skybake.train_sky() learn from by
-// default: the table path with the refined shell rule (TableRule::Refined)
-// and this many graded steps along each view ray. On `earth` it is within
-// 0.15% (mean) and 1% (p99) of the exact quadrature, against 1.7% and 7.6%
-// for the seed's rule at 16 steps (docs/neural.md, "Training targets").
+// default: the table path with the refined shell rule (TableRule::Refined),
+// these tables and this many graded steps along each view ray. On `earth` it
+// is within 0.15% (mean) and 1.0% (p99) of the exact quadrature, against
+// 1.7% and 7.6% for the seed's rule at 256 × 128 and 16 steps (docs/neural.md,
+// "Training targets").
 inline constexpr int kTrainingTargetSteps = 64;
+inline constexpr TableResolution kTrainingTargetTables{512, 256};
 
 struct NeuralTrainOptions {
     NeuralTopology topology;

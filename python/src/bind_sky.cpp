@@ -239,6 +239,7 @@ void bind_sky(py::module_& m) {
                 throw Error("epochs and iterations must be ≥ 0", "adam_epochs");
             SkyModelOptions targets;
             targets.steps = steps;
+            targets.tables = kTrainingTargetTables;
             return long_call(std::move(progress), [&] {
                 const SkyModel model(atmosphere, targets);
                 return train_neural_sky(model, o);
@@ -249,7 +250,7 @@ void bind_sky(py::module_& m) {
         py::arg("brightness") = "log", py::arg("table_rule") = "refined", py::arg("steps") = kTrainingTargetSteps,
         py::arg("device") = "cpu", py::arg("progress") = py::none(),
         "Trains a network on the table path of `atmosphere` (Adam, then Levenberg–Marquardt), as "
-        "`skybake sky train`: targets from the refined tables with 64 steps by default (table_rule="
+        "`skybake sky train`: targets from the refined 512 x 256 tables with 64 steps by default (table_rule="
         "'as-published', steps=16, brightness='linear' for the seed's setting). Deterministic for a seed. "
         "topology: 'paper' (324 weights), 'independent:16x16', 'shared:64x64', ...");
 }
