@@ -27,11 +27,15 @@ namespace {
 // Host memory the driver gives one chunk's words, origins, normals and
 // rotations; more vertices than this per chunk gain nothing.
 constexpr std::uint64_t kChunkBytes = std::uint64_t(256) << 20;
-// Chunks small enough that the progress bar moves and an interrupt is seen
-// soon, large enough that every thread has work: n / kChunksPerBake vertices,
-// at least kMinChunk.
+// Chunks small enough that the progress bar moves and an interrupt (Ctrl-C,
+// a cancelled callback) is seen soon, large enough that every thread has
+// work: n / kChunksPerBake vertices, at least kMinChunk, and at most
+// kChunkRays vertex–direction pairs (about half a second of rays on two
+// cores), but never under kSmallestChunk vertices.
 constexpr std::uint32_t kChunksPerBake = 32;
 constexpr std::uint32_t kMinChunk = 4096;
+constexpr std::uint64_t kChunkRays = std::uint64_t(1) << 23;
+constexpr std::uint32_t kSmallestChunk = 256;
 
 void check_inputs(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options) {
     validate_mesh(mesh, "mesh");
@@ -105,8 +109,11 @@ VisibilityBakeStats bake_points(const Mesh& mesh, std::uint32_t n, float ray_off
     // A GPU or raster tracer takes the largest chunk it allows (fewer launches,
     // fewer depth maps); a CPU tracer's chunks are sized for the progress bar
     // and interrupts.
-    const std::uint32_t wanted =
-        tracer.prefers_large_chunks() ? tracer_limit : std::max(n / kChunksPerBake, kMinChunk);
+    const auto ray_limit =
+        std::uint32_t(std::clamp<std::uint64_t>(kChunkRays / rule.size(), kSmallestChunk, 0xffffffffu));
+    const std::uint32_t wanted = tracer.prefers_large_chunks()
+                                     ? tracer_limit
+                                     : std::min(std::max(n / kChunksPerBake, kMinChunk), ray_limit);
     const std::uint32_t chunk =
         std::max<std::uint32_t>(1, std::min({wanted, tracer_limit, memory_limit, std::max(n, 1u)}));
 
