@@ -22,6 +22,8 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev glslang-tools
   # OpenGL (headless EGL and windowed GLFW)
   libegl-dev libgl-dev libglfw3-dev libepoxy-dev libegl-mesa0 libgl1-mesa-dri
+  # the viewer window: Dear ImGui, and a virtual X server for its tests
+  libimgui-dev xvfb xauth
   # Python bindings
   pybind11-dev python3-dev
 )

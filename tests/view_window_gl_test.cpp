@@ -1,0 +1,175 @@
+// The viewer's window (GLFW and Dear ImGui) under a virtual X server: a real
+// window opens, draws ten frames and closes with exit code 0, for a model and
+// for the planet; what it showed at the last frame is not blank and holds
+// both the panel and the lit model. Without a display: one line, exit 1.
+// Skips (with a message) when Xvfb is not installed or the build has no
+// window.
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "cli_runner.h"
+#include "skybake/image.h"
+#include "skybake/viewer.h"
+
+namespace skybake {
+namespace {
+
+namespace fs = std::filesystem;
+using test::run_cli;
+
+const std::string kNetwork = std::string(SKYBAKE_SOURCE_DIR) + "/tests/data/planet/sky_paper_dense.json";
+const char* const kTetra = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+
+std::string find_xvfb() {
+    for (const char* p : {"/usr/bin/Xvfb", "/usr/local/bin/Xvfb"})
+        if (access(p, X_OK) == 0)
+            return p;
+    return {};
+}
+
+// An Xvfb server on a free display (-displayfd), DISPLAY set while it lives.
+class VirtualDisplay {
+public:
+    VirtualDisplay() {
+        const std::string xvfb = find_xvfb();
+        if (xvfb.empty())
+            return;
+        int fds[2];
+        if (pipe(fds) != 0)
+            return;
+        pid_ = fork();
+        if (pid_ == 0) {
+            close(fds[0]);
+            const std::string fd = std::to_string(fds[1]);
+            execl(xvfb.c_str(), "Xvfb", "-displayfd", fd.c_str(), "-screen", "0", "640x480x24", "-nolisten", "tcp",
+                  static_cast<char*>(nullptr));
+            _exit(127);
+        }
+        close(fds[1]);
+        std::string number;
+        pollfd p{fds[0], POLLIN, 0};
+        char c = 0;
+        while (poll(&p, 1, 10000) > 0 && read(fds[0], &c, 1) == 1 && c != '\n')
+            number += c;
+        close(fds[0]);
+        if (number.empty())
+            return;
+        const char* old = std::getenv("DISPLAY");
+        old_display_ = old ? old : "";
+        had_display_ = old != nullptr;
+        setenv("DISPLAY", (":" + number).c_str(), 1);
+        display_ = ":" + number;
+    }
+    ~VirtualDisplay() {
+        if (pid_ > 0) {
+            kill(pid_, SIGTERM);
+            int status = 0;
+            waitpid(pid_, &status, 0);
+        }
+        if (!display_.empty()) {
+            if (had_display_)
+                setenv("DISPLAY", old_display_.c_str(), 1);
+            else
+                unsetenv("DISPLAY");
+        }
+    }
+    bool ready() const { return !display_.empty(); }
+
+private:
+    pid_t pid_ = -1;
+    std::string display_, old_display_;
+    bool had_display_ = false;
+};
+
+// Fraction of pixels whose colour differs from the first pixel's.
+double varied_fraction(const Image& img) {
+    const float* first = img.pixel(0, 0);
+    int n = 0;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            const float* p = img.pixel(x, y);
+            n += p[0] != first[0] || p[1] != first[1] || p[2] != first[2];
+        }
+    return double(n) / double(img.width * img.height);
+}
+
+class ViewWindow : public ::testing::Test {
+protected:
+    void SetUp() override {
+        if (!viewer_window_available())
+            GTEST_SKIP() << "this build has no window (GLFW or Dear ImGui missing)";
+        if (find_xvfb().empty())
+            GTEST_SKIP() << "Xvfb is not installed (Debian package xvfb)";
+        display_ = std::make_unique<VirtualDisplay>();
+        if (!display_->ready())
+            GTEST_SKIP() << "Xvfb did not start";
+        dir_ = test::temp_dir("view_window");
+    }
+    void TearDown() override { display_.reset(); }
+    std::unique_ptr<VirtualDisplay> display_;
+    std::string dir_;
+};
+
+TEST_F(ViewWindow, ModelWindowDrawsTenFramesAndCloses) {
+    const std::string obj = dir_ + "/tetra.obj", shot = dir_ + "/window.png";
+    std::ofstream(obj) << kTetra;
+    const auto r = run_cli({"view", obj, "--model", kNetwork, "--size", "320x240", "--frames", "10", "--window-capture",
+                            shot, "--sun-elevation-deg", "20"},
+                           120);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    ASSERT_TRUE(fs::exists(shot)) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ + "/window.partial.png"));
+    const Image img = load_image(shot);
+    EXPECT_EQ(img.width, 320);
+    EXPECT_EQ(img.height, 240);
+    EXPECT_GT(varied_fraction(img), 0.2); // the panel, the overlay and the model over the sky
+}
+
+TEST_F(ViewWindow, ReferenceSkyDprtAndVisibilityModesRun) {
+    const std::string obj = dir_ + "/tetra.obj";
+    std::ofstream(obj) << kTetra;
+    for (const char* shading : {"dprt", "visibility", "ao"}) {
+        const auto r = run_cli(
+            {"view", obj, "--size", "160x120", "--frames", "3", "--set", std::string("shading=") + shading}, 120);
+        EXPECT_EQ(r.exit_code, 0) << shading << ": " << r.err;
+    }
+}
+
+TEST_F(ViewWindow, PlanetWindowDrawsTenFramesAndCloses) {
+    const auto r = run_cli({"view", "planet", "--model", kNetwork, "--size", "160x120", "--frames", "10"}, 120);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
+TEST(ViewWindowNoDisplay, OneLineExitOne) {
+    if (!viewer_window_available())
+        GTEST_SKIP() << "this build has no window";
+    const std::string dir = test::temp_dir("view_nodisplay");
+    const std::string obj = dir + "/tetra.obj";
+    std::ofstream(obj) << kTetra;
+    const char* old = std::getenv("DISPLAY");
+    const std::string saved = old ? old : "";
+    unsetenv("DISPLAY");
+    const char* wl = std::getenv("WAYLAND_DISPLAY");
+    const std::string saved_wl = wl ? wl : "";
+    unsetenv("WAYLAND_DISPLAY");
+    const auto r = run_cli({"view", obj, "--frames", "2"}, 60);
+    if (old)
+        setenv("DISPLAY", saved.c_str(), 1);
+    if (wl)
+        setenv("WAYLAND_DISPLAY", saved_wl.c_str(), 1);
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(r.err_lines(), 1) << r.err;
+    EXPECT_NE(r.err.find("no display"), std::string::npos) << r.err;
+}
+
+} // namespace
+} // namespace skybake
