@@ -4,6 +4,7 @@
 // both the panel and the lit model. Without a display: one line, exit 1.
 // Skips (with a message) when Xvfb is not installed or the build has no
 // window.
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -142,6 +143,27 @@ TEST_F(ViewWindow, ReferenceSkyDprtAndVisibilityModesRun) {
             {"view", obj, "--size", "160x120", "--frames", "3", "--set", std::string("shading=") + shading}, 120);
         EXPECT_EQ(r.exit_code, 0) << shading << ": " << r.err;
     }
+}
+
+// The panel's bake (--bake presses its button at the first frame): a small
+// mesh is baked on the worker thread while the window draws, and the window
+// then shows the transfer; a large one is cancelled when the window closes
+// after two frames, without waiting for the bake to end.
+TEST_F(ViewWindow, BakeFromTheWindowFinishesOrIsCancelled) {
+    const std::string obj = dir_ + "/tetra.obj";
+    std::ofstream(obj) << kTetra;
+    const auto r = run_cli({"view", obj, "--size", "160x120", "--frames", "400", "--bake"}, 120);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("baked the transfer of 4 vertices (order 3)"), std::string::npos) << r.err;
+
+    const std::string big = dir_ + "/big.ply";
+    ASSERT_EQ(run_cli({"mesh", "generate", "--kind", "terrain", "-o", big, "--triangles", "400000"}, 120).exit_code, 0);
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto c = run_cli({"view", big, "--size", "160x120", "--frames", "2", "--bake"}, 120);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ASSERT_EQ(c.exit_code, 0) << c.err;
+    EXPECT_NE(c.err.find("bake cancelled"), std::string::npos) << c.err;
+    std::printf("cancelled bake: the window closed after %.2f s\n", seconds);
 }
 
 TEST_F(ViewWindow, PlanetWindowDrawsTenFramesAndCloses) {

@@ -29,7 +29,7 @@ struct ViewModelOpts {
     std::vector<std::string> set;
     double elevation = 30.0, azimuth = 0.0, altitude = 0.0;
     int frames = 1;
-    bool frames_given = false;
+    bool frames_given = false, bake = false;
 };
 
 // The panel's Bake button: `skybake prt bake`'s defaults (order 3, shadowed,
@@ -76,8 +76,14 @@ void run(const ViewModelOpts& o, const CLI::App& sub) {
         throw Error("this build has no window (GLFW or Dear ImGui was not found when it was configured); render an "
                     "image with --screenshot OUT.png",
                     "display");
-    if (!window)
+    if (!window) {
         check_output_path(o.screenshot, {".png", ".exr"}, "--screenshot");
+        if (o.bake)
+            throw UsageError("--bake is for the window; headless, bake with `skybake prt bake`", "--bake");
+        if (!o.window_capture.empty())
+            throw UsageError("--window-capture is for the window; headless, --screenshot writes the image",
+                             "--window-capture");
+    }
     ModelViewSettings st;
     bool sky_network = o.model.active();
     parse_flag("--size", [&] { parse_size(o.size, st.camera.width, st.camera.height, "--size"); });
@@ -179,6 +185,7 @@ void run(const ViewModelOpts& o, const CLI::App& sub) {
         vo.bake = make_viewer_bake();
         vo.screenshot = o.screenshot_path;
         vo.last_frame = o.window_capture;
+        vo.bake_at_start = o.bake;
         if (!o.window_capture.empty() && !o.frames_given)
             throw UsageError("--window-capture needs --frames N (the frame it writes is the last)", "--window-capture");
         if (!o.window_capture.empty())
@@ -236,6 +243,8 @@ void add_view_model(CLI::App& group) {
         ->capture_default_str();
     group.add_option("--window-capture", o->window_capture,
                      "In the window with --frames N: write the last frame as shown, panel included (PNG)");
+    group.add_flag("--bake", o->bake,
+                   "In the window: bake the transfer at once when the model has none (as the panel's button)");
     group.add_option("--size", o->size, "Image size WxH in pixels")->capture_default_str();
     o->atm.add(group);
     o->model.add(group);

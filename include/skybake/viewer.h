@@ -173,9 +173,10 @@ struct ModelViewerOptions {
     std::string screenshot = "skybake_view.png"; // where the screenshot key (P) writes
     std::string last_frame;          // non-empty: the window as shown (panel included) at the last frame, PNG
     std::string title = "skybake view";
-    // The skies the panel offers (network / reference): one or both non-null,
-    // outliving the call; the first non-null one of {start_network ? network
-    // : reference} is shown first.
+    // The skies the panel offers (network / reference), outliving the call:
+    // reference non-null, network may be null; start_network (with a
+    // network) shows it first. The panel may replace both (an atmosphere
+    // preset, a weights file).
     const SkySource* network = nullptr;
     const SkySource* reference = nullptr;
     bool start_network = true;
@@ -185,6 +186,7 @@ struct ModelViewerOptions {
     // progress callback (skybake/progress.h), cancelled by skybake::Interrupted
     // thrown from it. Empty: no button.
     std::function<ViewerModel(const ViewerModel& model)> bake;
+    bool bake_at_start = false; // press the Bake button at the first frame (when the model has no transfer)
 };
 // Runs until the window is closed (or `frames` are drawn). Throws
 // skybake::Error (where: "display") when there is no display or the build has

@@ -11,12 +11,13 @@
 #if defined(SKYBAKE_HAS_WINDOW)
 
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <csignal>
+#include <filesystem>
 #include <future>
-#include <mutex>
-#include <optional>
-#include <thread>
+#include <string>
+#include <vector>
 
 #include <fmt/format.h>
 #include <imgui.h>
@@ -24,7 +25,9 @@
 #include "render/window_shell.h" // GL and GLFW first
 #include "skybake/error.h"
 #include "skybake/interrupt.h"
+#include "skybake/neural.h"
 #include "skybake/progress.h"
+#include "skybake/sky.h"
 #include "skybake/viewer.h"
 
 namespace skybake {
@@ -73,16 +76,20 @@ private:
 } // namespace
 
 void run_model_viewer(const ViewerModel& start_model, const ModelViewerOptions& o) {
-    if (!o.network && !o.reference)
-        throw Error("the viewer needs a sky (a network or the reference sky)", "sky");
+    if (!o.reference)
+        throw Error("the viewer needs the reference sky (and may have a network)", "sky");
     WindowShell shell(o.view.camera.width, o.view.camera.height, o.title, o.frames);
     ToneMapper tone;
     ViewerModel model = start_model;
-    bool use_network = o.start_network && o.network;
+    // The skies: those of the command line, or ones chosen in the panel (a preset, a weights file).
+    const SkySource* network = o.network;
+    const SkySource* reference = o.reference;
+    std::unique_ptr<SkySource> own_network, own_reference;
+    bool use_network = o.start_network && network;
     std::unique_ptr<ModelRenderer> renderer;
     auto rebuild = [&] {
         renderer.reset();
-        const SkySource& sky = use_network ? *o.network : *o.reference;
+        const SkySource& sky = use_network ? *network : *reference;
         const int order = model.has_transfer() ? model.transfer.order : 3;
         renderer = std::make_unique<ModelRenderer>(model, sky, o.light_rule, order, ModelRenderer::InCurrentContext{});
     };
@@ -98,11 +105,17 @@ void run_model_viewer(const ViewerModel& start_model, const ModelViewerOptions& 
     glm::vec3 albedo = model.albedo.empty() ? glm::vec3(0.8f) : model.albedo.front();
     bool albedo_override = false;
     int shading = int(st.shading), shadow = int(st.sun_shadow), direction = st.visibility_direction;
+    const std::vector<std::string> presets = atmosphere_preset_names();
+    std::string preset_label = "(command line)";
+    char weights_path[512] = "";
     std::unique_ptr<BakeJob> bake;
     std::string bake_message;
     std::string message;
     ModelFrameStats stats;
 
+    const auto bake_started = std::chrono::steady_clock::now();
+    if (o.bake_at_start && o.bake && !model.has_transfer())
+        bake = std::make_unique<BakeJob>(o.bake, model);
     while (shell.begin_frame()) {
         const double dt = shell.seconds_per_frame();
         orbit.update(shell);
@@ -133,13 +146,49 @@ void run_model_viewer(const ViewerModel& start_model, const ModelViewerOptions& 
         ImGui::Checkbox("animate the sun (Space)", &animate);
         ImGui::SliderFloat("altitude", &altitude, 0.0f, 20.0f, "%.2f km");
         int sky_choice = use_network ? 0 : 1;
-        if (o.network && o.reference) {
+        if (network && reference) {
             if (ImGui::Combo("sky", &sky_choice, "network\0reference\0") && (sky_choice == 0) != use_network) {
                 use_network = sky_choice == 0;
                 rebuild();
             }
         } else {
             ImGui::Text("sky: %s", use_network ? "network" : "reference");
+        }
+        // Another atmosphere: a preset (the reference sky, its tables built now) or a weights file.
+        if (ImGui::BeginCombo("atmosphere", preset_label.c_str())) {
+            for (const std::string& name : presets)
+                if (ImGui::Selectable(name.c_str(), name == preset_label)) {
+                    try {
+                        own_reference =
+                            std::make_unique<SkySource>(SkySource::reference(SkyModel(atmosphere_preset(name))));
+                        reference = own_reference.get();
+                        use_network = false;
+                        preset_label = name;
+                        rebuild();
+                        message.clear();
+                    } catch (const Error& e) {
+                        message = e.what();
+                    }
+                }
+            ImGui::EndCombo();
+        }
+        ImGui::InputText("weights", weights_path, sizeof weights_path);
+        ImGui::SameLine();
+        if (ImGui::Button("load")) {
+            try {
+                NeuralSky net = load_neural_sky(weights_path);
+                auto ref = std::make_unique<SkySource>(SkySource::reference(neural_reference_model(net)));
+                own_network = std::make_unique<SkySource>(SkySource::network(std::move(net)));
+                own_reference = std::move(ref);
+                network = own_network.get();
+                reference = own_reference.get();
+                use_network = true;
+                preset_label = std::filesystem::path(weights_path).filename().string();
+                rebuild();
+                message.clear();
+            } catch (const Error& e) {
+                message = e.what();
+            }
         }
         ImGui::Checkbox("sky background", &st.sky_background);
         ImGui::Checkbox("sun", &st.sun);
@@ -167,6 +216,8 @@ void run_model_viewer(const ViewerModel& start_model, const ModelViewerOptions& 
                 ImGui::TextUnformatted("no baked transfer: unshadowed");
                 if (ImGui::Button("bake the transfer"))
                     bake = std::make_unique<BakeJob>(o.bake, model);
+                ImGui::SameLine();
+                ImGui::TextDisabled("(order 3, lebedev:590)");
             } else {
                 ImGui::ProgressBar(bake->fraction(), ImVec2(200, 0));
                 ImGui::SameLine();
@@ -188,9 +239,13 @@ void run_model_viewer(const ViewerModel& start_model, const ModelViewerOptions& 
                     model = std::move(baked);
                     rebuild();
                     bake_message.clear();
+                    fmt::print(stderr, "baked the transfer of {} vertices (order {}) in {:.2f} s\n",
+                               model.mesh.vertex_count(), model.transfer.order,
+                               std::chrono::duration<double>(std::chrono::steady_clock::now() - bake_started).count());
                 }
             } catch (const Error& e) {
                 bake_message = bake->cancelled() ? "bake cancelled" : fmt::format("bake failed: {}", e.what());
+                fmt::print(stderr, "{}\n", bake_message);
             }
             bake.reset();
         }
@@ -240,7 +295,11 @@ void run_model_viewer(const ViewerModel& start_model, const ModelViewerOptions& 
         const bool last = o.frames > 0 && shell.frames_drawn() + 1 == o.frames;
         shell.end_frame(last && !o.last_frame.empty() ? std::filesystem::path(o.last_frame) : std::filesystem::path());
     }
-    bake.reset();
+    if (bake) {
+        bake->cancel();
+        bake.reset();
+        fmt::print(stderr, "bake cancelled (the window closed)\n");
+    }
     renderer.reset();
 }
 
