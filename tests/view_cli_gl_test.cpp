@@ -70,8 +70,8 @@ protected:
     static Image view(const std::string& name, const std::string& elevation, std::vector<std::string> set = {},
                       const std::string& azimuth = "0") {
         const std::string out = dir_ + "/" + name + ".exr";
-        std::vector<std::string> args = {"view",     baked_,   "--screenshot",        out,       "--size",
-                                         "160x120",  "--model", kNetwork,             "--sun-elevation-deg",
+        std::vector<std::string> args = {"view",    baked_,   "--screenshot",        out,       "--size",
+                                         "160x120", "--model", kNetwork,           "--sun-elevation-deg",
                                          elevation, "--sun-azimuth-deg", azimuth};
         set.insert(set.begin(), "exposure=0");
         set.insert(set.begin(), "shadow=vertex");
@@ -290,13 +290,15 @@ TEST_F(ViewCli, DprtMatchesRelightGlossy) {
 
 // The reference sky behind the model: each background pixel against
 // SkySource::evaluate() along its ray through preview_camera() (the map is
-// bilinear in 512 × 256 texels: within 3 %, or 10⁻⁴ of the brightest pixel
+// bilinear in 256 × 256 texels of relative azimuth and zenith angle: within
+// 3 %, or 10⁻⁴ of the brightest pixel
 // below the horizon, where the tables' radiance is ~10⁻⁶ and jitters), blue
 // above the horizon at noon.
 TEST_F(ViewCli, ReferenceSkyBackground) {
-    const Image img = view("reference_bg", "60", {"sky=reference", "sun=off", "samples=1", "view=35,5"});
-    const Image bare = view("reference_bare", "60", {"sky=reference", "sun=off", "samples=1", "view=35,5",
-                                                     "background=none"});
+    // The sun off to the side (azimuth 100°; the camera looks from azimuth 35°).
+    const Image img = view("reference_bg", "60", {"sky=reference", "sun=off", "samples=1", "view=35,5"}, "100");
+    const Image bare = view("reference_bare", "60",
+                            {"sky=reference", "sun=off", "samples=1", "view=35,5", "background=none"}, "100");
     const SkySource sky = SkySource::reference(neural_reference_model(load_neural_sky(kNetwork)));
     AoPreviewOptions o;
     o.width = img.width;
@@ -304,7 +306,7 @@ TEST_F(ViewCli, ReferenceSkyBackground) {
     o.azimuth_deg = 35.0f;
     o.elevation_deg = 5.0f;
     const PreviewCamera c = preview_camera(load_mesh(baked_), o);
-    const glm::vec3 sun = sun_direction(60.0, 0.0);
+    const glm::vec3 sun = sun_direction(60.0, 100.0);
     const float density = float(sky.atmosphere().density_from_altitude(0.0));
     std::vector<SkySample> samples;
     std::vector<std::pair<int, int>> where;

@@ -82,7 +82,7 @@ void upload_equirect(Texture& tex, const std::vector<glm::vec3>& texels, int wid
     glBindTexture(GL_TEXTURE_2D, 0);
 }
 
-constexpr int kSkyMapWidth = 512, kSkyMapHeight = 256;  // the reference sky's background
+constexpr int kSkyMapWidth = 256, kSkyMapHeight = 256;  // the reference sky's background: ψ × θ, 0.7° texels
 constexpr int kGlossyMapWidth = 128, kGlossyMapHeight = 64; // the prefiltered glossy layer
 constexpr int kShadowMapSize = 2048;
 
@@ -280,20 +280,27 @@ struct ModelRenderer::Impl {
         }
     }
 
-    // The reference sky seen from the observer, per texel of the background map.
+    // The reference sky seen from the observer, per texel of the background map. The sky depends
+    // on the view's azimuth only relative to the sun's, so the map is indexed by that relative
+    // azimuth ψ ∈ [0, π] (it is symmetric about the sun's vertical plane) and the zenith angle
+    // θ ∈ [0, π]: texel (i, j) holds ψ = π (i + ½)/width, θ = π (j + ½)/height, and the map is
+    // computed again when the sun's elevation or the altitude changes, not its azimuth.
     void update_sky_map(ModelFrameStats* stats) {
         if (have_sky_map && light_settings.sun_elevation_deg == sky_map_settings.sun_elevation_deg &&
-            light_settings.sun_azimuth_deg == sky_map_settings.sun_azimuth_deg &&
             light_settings.altitude_km == sky_map_settings.altitude_km)
             return;
         const auto t0 = Clock::now();
-        const glm::vec3 s = sun_direction(light_settings.sun_elevation_deg, light_settings.sun_azimuth_deg);
+        const glm::vec3 s = sun_direction(light_settings.sun_elevation_deg, 0.0);
         const float density =
             float(std::clamp(sky->atmosphere().density_from_altitude(light_settings.altitude_km), 1e-30, 1.0));
         std::vector<SkySample> samples(std::size_t(kSkyMapWidth) * kSkyMapHeight);
         for (int j = 0; j < kSkyMapHeight; ++j)
             for (int i = 0; i < kSkyMapWidth; ++i) {
-                const glm::vec3 d = equirect_direction(i, j, kSkyMapWidth, kSkyMapHeight);
+                const double psi = M_PI * (double(i) + 0.5) / double(kSkyMapWidth);
+                const double theta = M_PI * (double(j) + 0.5) / double(kSkyMapHeight);
+                // The direction at relative azimuth ψ from the sun's (which is towards +z here).
+                const glm::vec3 d(float(std::sin(theta) * std::sin(psi)), float(std::cos(theta)),
+                                  float(std::sin(theta) * std::cos(psi)));
                 SkySample& q = samples[std::size_t(j) * kSkyMapWidth + std::size_t(i)];
                 q.cos_view_zenith = std::clamp(d.y, -1.0f, 1.0f);
                 q.cos_view_sun = std::clamp(glm::dot(d, s), -1.0f, 1.0f);
@@ -305,6 +312,9 @@ struct ModelRenderer::Impl {
         for (glm::vec3& r : radiance)
             r = glm::max(r, glm::vec3(0.0f));
         upload_equirect(sky_map, radiance, kSkyMapWidth, kSkyMapHeight);
+        glBindTexture(GL_TEXTURE_2D, sky_map.get());
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glBindTexture(GL_TEXTURE_2D, 0);
         sky_map_settings = light_settings;
         have_sky_map = true;
         if (stats)

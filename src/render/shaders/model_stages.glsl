@@ -1,6 +1,6 @@
 // Stage bodies of the model viewer, one per SKYBAKE_STAGE_* define:
 //   BACKGROUND_VS / BACKGROUND_FS  the sky network per pixel (full-screen triangle),
-//   BACKGROUND_MAP_FS              the reference sky's equirectangular map per pixel,
+//   BACKGROUND_MAP_FS              the reference sky's map (relative azimuth × zenith angle) per pixel,
 //   MODEL_VS / MODEL_FS            the model: relight() of skybake/prt.h per vertex,
 //                                  the sun per pixel (shadow map) and the DPRT glossy layer,
 //   FLAT_VS / FLAT_FS              the same mesh in one constant colour (baseline),
@@ -46,13 +46,18 @@ uniform vec3 u_up;
 uniform float u_tan_half_fov_y;
 uniform float u_aspect;
 uniform vec2 u_viewport;      // pixels
-uniform sampler2D u_sky_map;  // the reference sky, equirectangular (sb_equirect_uv)
+uniform vec3 u_sun;            // unit, towards the sun, +y up
+uniform sampler2D u_sky_map;  // the reference sky by (relative azimuth ψ / π, zenith angle θ / π)
 out vec4 o_colour;
 void main() {
     float cx = (2.0 * gl_FragCoord.x / u_viewport.x - 1.0) * u_tan_half_fov_y * u_aspect;
     float cy = (2.0 * gl_FragCoord.y / u_viewport.y - 1.0) * u_tan_half_fov_y;
     vec3 d = normalize(u_forward + cx * u_right + cy * u_up);
-    o_colour = vec4(max(texture(u_sky_map, sb_equirect_uv(d)).rgb, vec3(0.0)), 0.0);
+    // ψ: the angle between the horizontal parts of the view and the sun (0 with the sun at the zenith).
+    vec2 dh = d.xz, sh = u_sun.xz;
+    float psi = dot(sh, sh) > 1e-12 ? atan(abs(dh.x * sh.y - dh.y * sh.x), dot(dh, sh)) : 0.0;
+    vec2 uv = vec2(psi * 0.318309886, acos(clamp(d.y, -1.0, 1.0)) * 0.318309886);
+    o_colour = vec4(max(texture(u_sky_map, uv).rgb, vec3(0.0)), 0.0);
 }
 #elif defined(SKYBAKE_STAGE_MODEL_VS)
 layout(location = 0) in vec3 a_position;
