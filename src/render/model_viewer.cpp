@@ -158,16 +158,20 @@ void run_model_viewer(const ViewerModel& start_model, const ModelViewerOptions& 
         if (ImGui::BeginCombo("atmosphere", preset_label.c_str())) {
             for (const std::string& name : presets)
                 if (ImGui::Selectable(name.c_str(), name == preset_label)) {
+                    std::unique_ptr<SkySource> sky;
                     try {
-                        own_reference =
-                            std::make_unique<SkySource>(SkySource::reference(SkyModel(atmosphere_preset(name))));
+                        sky = std::make_unique<SkySource>(SkySource::reference(SkyModel(atmosphere_preset(name))));
+                    } catch (const Error& e) {
+                        message = e.what();
+                    }
+                    if (sky) {
+                        renderer.reset(); // it points at the sky it replaces
+                        own_reference = std::move(sky);
                         reference = own_reference.get();
                         use_network = false;
                         preset_label = name;
                         rebuild();
                         message.clear();
-                    } catch (const Error& e) {
-                        message = e.what();
                     }
                 }
             ImGui::EndCombo();
@@ -175,19 +179,24 @@ void run_model_viewer(const ViewerModel& start_model, const ModelViewerOptions& 
         ImGui::InputText("weights", weights_path, sizeof weights_path);
         ImGui::SameLine();
         if (ImGui::Button("load")) {
+            std::unique_ptr<SkySource> net_sky, ref_sky;
             try {
                 NeuralSky net = load_neural_sky(weights_path);
-                auto ref = std::make_unique<SkySource>(SkySource::reference(neural_reference_model(net)));
-                own_network = std::make_unique<SkySource>(SkySource::network(std::move(net)));
-                own_reference = std::move(ref);
+                ref_sky = std::make_unique<SkySource>(SkySource::reference(neural_reference_model(net)));
+                net_sky = std::make_unique<SkySource>(SkySource::network(std::move(net)));
+            } catch (const Error& e) {
+                message = e.what();
+            }
+            if (net_sky) {
+                renderer.reset(); // it points at the skies it replaces
+                own_network = std::move(net_sky);
+                own_reference = std::move(ref_sky);
                 network = own_network.get();
                 reference = own_reference.get();
                 use_network = true;
                 preset_label = std::filesystem::path(weights_path).filename().string();
                 rebuild();
                 message.clear();
-            } catch (const Error& e) {
-                message = e.what();
             }
         }
         ImGui::Checkbox("sky background", &st.sky_background);

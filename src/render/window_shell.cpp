@@ -12,11 +12,16 @@
 #include <imgui.h>
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
+#include <imgui_internal.h>
 
 #include "render/shaders.h"
 #include "skybake/error.h"
 
 namespace skybake::render {
+
+namespace {
+void ignore_imgui_message(void*, const char*, ...) {}
+} // namespace
 
 WindowShell::WindowShell(int width, int height, const std::string& title, int frame_limit) : frame_limit_(frame_limit) {
     glfwSetErrorCallback([](int, const char*) {});
@@ -61,6 +66,11 @@ WindowShell::WindowShell(int width, int height, const std::string& title, int fr
 
 WindowShell::~WindowShell() {
     make_current();
+    // An error thrown in the middle of a frame (while the panel was built): close the frame first.
+    if (ImGuiContext* c = ImGui::GetCurrentContext(); c && c->WithinFrameScope) {
+        ImGui::ErrorCheckEndFrameRecover(ignore_imgui_message); // the missing End() calls
+        ImGui::EndFrame();
+    }
     if (imgui_gl_)
         ImGui_ImplOpenGL3_Shutdown();
     if (imgui_glfw_)
