@@ -437,6 +437,32 @@ void expect_one_line_failure(const test::CliResult& r, const std::string& out, c
     EXPECT_FALSE(fs::exists(out));
 }
 
+// The new settings refuse bad values with one line naming --set, exit 2, nothing written.
+TEST(ViewCliModels, BadNewSettingsAreOneLine) {
+    const std::string dir = test::temp_dir("view_bad_settings");
+    const std::string obj = dir + "/tetra.obj", out = dir + "/x.png";
+    std::ofstream(obj) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    for (const char* bad : {"shading=glossy", "shadow=soft", "phong=0", "specular=-1", "sky=network", "sky=cloudy",
+                            "zoom=0", "direction=-1"}) {
+        const auto r = run_cli({"view", obj, "--screenshot", out, "--size", "32x24", "--set", bad});
+        EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.err;
+        EXPECT_EQ(r.err_lines(), 1) << bad << ": " << r.err;
+        EXPECT_NE(r.err.find("--set"), std::string::npos) << bad << ": " << r.err;
+        EXPECT_FALSE(fs::exists(out)) << bad;
+    }
+    // A direction beyond the rule: one line from the renderer, exit 1.
+    const auto r = run_cli({"view", obj, "--screenshot", out, "--size", "32x24", "--rule", "lebedev:6", "--set",
+                            "shading=visibility", "--set", "direction=6"});
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(r.err_lines(), 1) << r.err;
+    EXPECT_NE(r.err.find("not in the light's rule"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+    // Headless, the window's flags are refused.
+    const auto b = run_cli({"view", obj, "--screenshot", out, "--bake"});
+    EXPECT_EQ(b.exit_code, 2) << b.err;
+    EXPECT_NE(b.err.find("--bake"), std::string::npos) << b.err;
+}
+
 TEST(ViewCliModels, BrokenFileIsOneLine) {
     const std::string dir = test::temp_dir("view_broken");
     const std::string glb = dir + "/broken.glb", out = dir + "/x.png";
