@@ -1,7 +1,9 @@
 // The viewer's window (GLFW and Dear ImGui) under a virtual X server: a real
 // window opens, draws ten frames and closes with exit code 0, for a model and
 // for the planet; what it showed at the last frame is not blank and holds
-// both the panel and the lit model. Without a display: one line, exit 1.
+// both the panel and the lit model; it equals the headless screenshot of the
+// same view; a bake from the window finishes, or is cancelled when the window
+// closes. Without a display: one line, exit 1.
 // Skips (with a message) when Xvfb is not installed or the build has no
 // window.
 #include <chrono>
@@ -10,6 +12,7 @@
 #include <fstream>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <poll.h>
@@ -133,6 +136,39 @@ TEST_F(ViewWindow, ModelWindowDrawsTenFramesAndCloses) {
     EXPECT_EQ(img.width, 320);
     EXPECT_EQ(img.height, 240);
     EXPECT_GT(varied_fraction(img), 0.2); // the panel, the overlay and the model over the sky
+}
+
+// What the window shows is the headless screenshot: the same renderer in the
+// window's context and its tone map in GLSL against save_image()'s ACES, on
+// the same camera. Below the overlay (rows ≥ 100; the panel folded), every
+// channel within 2 of 255 on 99 % of the pixels.
+TEST_F(ViewWindow, WindowShowsTheHeadlessImage) {
+    const std::string obj = dir_ + "/tetra.obj", shot = dir_ + "/window.png", head = dir_ + "/headless.png";
+    std::ofstream(obj) << kTetra;
+    const std::vector<std::string> common = {
+        "view", obj,     "--model",    kNetwork, "--size",    "320x240", "--sun-elevation-deg",
+        "20",   "--set", "exposure=3", "--set",  "view=35,-5"};
+    std::vector<std::string> w = common, h = common;
+    w.insert(w.end(), {"--frames", "3", "--fold-panel", "--window-capture", shot});
+    h.insert(h.end(), {"--screenshot", head, "--set", "samples=1"});
+    const auto rw = run_cli(w, 120), rh = run_cli(h, 120);
+    ASSERT_EQ(rw.exit_code, 0) << rw.err;
+    ASSERT_EQ(rh.exit_code, 0) << rh.err;
+    const Image a = load_image(shot), b = load_image(head);
+    ASSERT_EQ(a.width, b.width);
+    ASSERT_EQ(a.height, b.height);
+    int n = 0, close = 0;
+    for (int y = 100; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x) {
+            bool ok = true;
+            for (int c = 0; c < 3; ++c)
+                ok = ok &&
+                     std::abs(linear_to_srgb(a.pixel(x, y)[c]) - linear_to_srgb(b.pixel(x, y)[c])) <= 2.5f / 255.0f;
+            ++n;
+            close += ok;
+        }
+    std::printf("window vs headless: %d of %d pixels within 2/255\n", close, n);
+    EXPECT_GE(close, n * 99 / 100);
 }
 
 TEST_F(ViewWindow, ReferenceSkyDprtAndVisibilityModesRun) {

@@ -29,7 +29,7 @@ struct ViewModelOpts {
     std::vector<std::string> set;
     double elevation = 30.0, azimuth = 0.0, altitude = 0.0;
     int frames = 1;
-    bool frames_given = false, bake = false;
+    bool frames_given = false, bake = false, fold_panel = false;
 };
 
 // The panel's Bake button: `skybake prt bake`'s defaults (order 3, shadowed,
@@ -186,6 +186,7 @@ void run(const ViewModelOpts& o, const CLI::App& sub) {
         vo.screenshot = o.screenshot_path;
         vo.last_frame = o.window_capture;
         vo.bake_at_start = o.bake;
+        vo.panel_folded = o.fold_panel;
         if (!o.window_capture.empty() && !o.frames_given)
             throw UsageError("--window-capture needs --frames N (the frame it writes is the last)", "--window-capture");
         if (!o.window_capture.empty())
@@ -245,6 +246,7 @@ void add_view_model(CLI::App& group) {
                      "In the window with --frames N: write the last frame as shown, panel included (PNG)");
     group.add_flag("--bake", o->bake,
                    "In the window: bake the transfer at once when the model has none (as the panel's button)");
+    group.add_flag("--fold-panel", o->fold_panel, "In the window: start with the panel folded");
     group.add_option("--size", o->size, "Image size WxH in pixels")->capture_default_str();
     o->atm.add(group);
     o->model.add(group);

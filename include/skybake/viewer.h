@@ -187,6 +187,7 @@ struct ModelViewerOptions {
     // thrown from it. Empty: no button.
     std::function<ViewerModel(const ViewerModel& model)> bake;
     bool bake_at_start = false; // press the Bake button at the first frame (when the model has no transfer)
+    bool panel_folded = false;  // start with the panel folded to its title bar
 };
 // Runs until the window is closed (or `frames` are drawn). Throws
 // skybake::Error (where: "display") when there is no display or the build has

@@ -140,6 +140,7 @@ void run_model_viewer(const ViewerModel& start_model, const ModelViewerOptions& 
 
         // The panel.
         ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+        ImGui::SetNextWindowCollapsed(o.panel_folded, ImGuiCond_FirstUseEver);
         ImGui::Begin("skybake view", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
         ImGui::SliderFloat("sun elevation", &sun_el, -20.0f, 90.0f, "%.1f deg");
         ImGui::SliderFloat("sun azimuth", &sun_az, -180.0f, 180.0f, "%.1f deg");
