@@ -1,6 +1,7 @@
-// skybake view MODEL.glb --screenshot OUT.png|.exr [--size WxH] [--sun-elevation-deg E]
+// skybake view MODEL.glb [--screenshot OUT.png|.exr] [--size WxH] [--sun-elevation-deg E]
 //                        [--sun-azimuth-deg A] [--altitude-km H] [--model W.json | --preset P]
 //                        [--rule R] [--frames N] [--set key=value ...]
+//                        [--screenshot-path P.png] [--window-capture OUT.png] [--bake] [--fold-panel]
 // A model lit by the sky on OpenGL (skybake/viewer.h): without --screenshot
 // in a window with a Dear ImGui panel, else rendered headless.
 #include <algorithm>
