@@ -3,8 +3,12 @@
 // order 4 through per-vertex transfer, with the network per pixel behind it,
 // against a flat-shaded pass over the same mesh in the same run (counter
 // vs_flat = frame time / flat time); and the cost of moving the sun: the SH
-// projection of the sky (lebedev:2030, the network on the CPU) and the
-// per-vertex sun visibility (Embree), counted apart from the draw.
+// projection of the sky (lebedev:2030, the network on the CPU) and the sun's
+// shadow (the shadow map, or the per-vertex visibility by Embree), counted
+// apart from the draw. Also the frame with the DPRT glossy layer (shading
+// dprt, its map of the mirror direction rebuilt when the light moves), and
+// the reference sky's background map (256 × 256 evaluations of the tables)
+// when the sun rises.
 //
 // The transfer is the analytic unshadowed one of order 4 (25 grey
 // coefficients, 7 vertex attributes): the frame costs the same for any
@@ -65,9 +69,16 @@ ModelViewSettings settings() {
     return s;
 }
 
-void BM_Viewer_100k_Prt4_NetworkPerPixel_1080p(benchmark::State& state) {
+const SkySource& reference_sky() {
+    static const SkySource s = SkySource::reference(neural_reference_model(
+        load_neural_sky(std::string(SKYBAKE_SOURCE_DIR) + "/tests/data/planet/sky_paper.json")));
+    return s;
+}
+
+void frame_vs_flat(benchmark::State& state, ModelShading shading) {
     ModelRenderer r(model(), sky(), parse_rule("lebedev:2030"), 4);
     ModelViewSettings s = settings();
+    s.shading = shading;
     ModelFrameStats st;
     r.render(s, &st); // warm up: the light, the sun, the shaders
     r.render_flat(s, &st);
@@ -89,13 +100,23 @@ void BM_Viewer_100k_Prt4_NetworkPerPixel_1080p(benchmark::State& state) {
     state.counters["vs_flat"] = draw / flat;
     state.SetLabel(r.device_description());
 }
+
+void BM_Viewer_100k_Prt4_NetworkPerPixel_1080p(benchmark::State& state) {
+    frame_vs_flat(state, ModelShading::Prt);
+}
 BENCHMARK(BM_Viewer_100k_Prt4_NetworkPerPixel_1080p)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);
 
-// The sun moves one degree per frame: the sky SH recompute and the sun
-// visibility of every vertex (the draw is not counted).
-void BM_Viewer_SunMove_SkySh4(benchmark::State& state) {
+void BM_Viewer_100k_Dprt4_NetworkPerPixel_1080p(benchmark::State& state) {
+    frame_vs_flat(state, ModelShading::Dprt);
+}
+BENCHMARK(BM_Viewer_100k_Dprt4_NetworkPerPixel_1080p)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);
+
+// The sun moves one degree per frame: the sky SH recompute and the sun's
+// shadow (the draw is not counted). shadow: 0 map, 1 per vertex.
+void sun_move(benchmark::State& state, SunShadow shadow) {
     ModelRenderer r(model(), sky(), parse_rule("lebedev:2030"), 4);
     ModelViewSettings s = settings();
+    s.sun_shadow = shadow;
     s.camera.width = 64;
     s.camera.height = 36;
     ModelFrameStats st;
@@ -111,10 +132,41 @@ void BM_Viewer_SunMove_SkySh4(benchmark::State& state) {
         ++n;
     }
     state.counters["sky_sh_ms"] = 1e3 * light / n;
-    state.counters["sun_visibility_ms"] = 1e3 * sun / n;
+    state.counters["sun_shadow_ms"] = 1e3 * sun / n;
     state.counters["vertices"] = double(st.vertices);
 }
+
+void BM_Viewer_SunMove_SkySh4(benchmark::State& state) {
+    sun_move(state, SunShadow::Vertex);
+}
 BENCHMARK(BM_Viewer_SunMove_SkySh4)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(10);
+
+void BM_Viewer_SunMove_SkySh4_ShadowMap(benchmark::State& state) {
+    sun_move(state, SunShadow::Map);
+}
+BENCHMARK(BM_Viewer_SunMove_SkySh4_ShadowMap)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(10);
+
+// The reference sky's background map when the sun rises (CPU, the tables;
+// a move in azimuth alone costs nothing, the map being relative to the sun's azimuth).
+void BM_Viewer_SunRise_ReferenceBackground(benchmark::State& state) {
+    ModelRenderer r(model(), reference_sky(), parse_rule("lebedev:2030"), 4);
+    ModelViewSettings s = settings();
+    s.camera.width = 64;
+    s.camera.height = 36;
+    ModelFrameStats st;
+    r.render(s, &st);
+    double map = 0.0;
+    int n = 0;
+    for (auto _ : state) {
+        s.sun_elevation_deg += 0.5;
+        r.render(s, &st);
+        state.SetIterationTime(st.background_seconds);
+        map += st.background_seconds;
+        ++n;
+    }
+    state.counters["background_map_ms"] = 1e3 * map / n;
+}
+BENCHMARK(BM_Viewer_SunRise_ReferenceBackground)->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(5);
 
 } // namespace
 

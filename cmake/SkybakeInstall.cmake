@@ -5,6 +5,9 @@ set(skybake_targets skybake)
 foreach(m IN LISTS SKYBAKE_MODULES)
   list(APPEND skybake_targets skybake_${m})
 endforeach()
+if(TARGET skybake_imgui_backends)
+  list(APPEND skybake_targets skybake_imgui_backends)
+endif()
 
 install(TARGETS ${skybake_targets} EXPORT skybakeTargets
   ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}

@@ -22,10 +22,10 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev glslang-tools
   # OpenGL (headless EGL and windowed GLFW)
   libegl-dev libgl-dev libglfw3-dev libepoxy-dev libegl-mesa0 libgl1-mesa-dri
+  # the viewer window: Dear ImGui, and a virtual X server for tests of real windows
+  libimgui-dev xvfb xauth
   # Python module, its tests, and the Blender add-on's
   pybind11-dev python3-dev python3-numpy python3-pytest blender
-  # tests of real windows
-  xvfb xauth
 )
 
 missing=()

@@ -1,9 +1,13 @@
-// skybake view MODEL.glb --screenshot OUT.png|.exr [--size WxH] [--sun-elevation-deg E]
+// skybake view MODEL.glb [--screenshot OUT.png|.exr] [--size WxH] [--sun-elevation-deg E]
 //                        [--sun-azimuth-deg A] [--altitude-km H] [--model W.json | --preset P]
 //                        [--rule R] [--frames N] [--set key=value ...]
-// A model lit by the sky on OpenGL (skybake/viewer.h), rendered headless.
+//                        [--screenshot-path P.png] [--window-capture OUT.png] [--bake] [--fold-panel]
+// A model lit by the sky on OpenGL (skybake/viewer.h): without --screenshot
+// in a window with a Dear ImGui panel, else rendered headless.
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <optional>
 #include <sstream>
 
 #include "cli.h"
@@ -11,19 +15,49 @@
 #include "flags.h"
 #include "sky_common.h"
 #include "skybake/viewer.h"
+#include "skybake/visibility.h"
 
 namespace skybake::cli {
 
 namespace {
 
+namespace fs = std::filesystem;
+
 struct ViewModelOpts {
     AtmosphereFlags atm;
     ModelFlag model;
-    std::string input, screenshot, size = "960x720", rule = "lebedev:2030";
+    std::string input, screenshot, window_capture, screenshot_path = "skybake_view.png", size = "960x720", rule = "lebedev:2030";
     std::vector<std::string> set;
     double elevation = 30.0, azimuth = 0.0, altitude = 0.0;
     int frames = 1;
+    bool frames_given = false, bake = false, fold_panel = false;
 };
+
+// The panel's Bake button: `skybake prt bake`'s defaults (order 3, shadowed,
+// lebedev:590) on the best backend this build has (CUDA when it has one and
+// a GPU answers, else Embree).
+std::function<ViewerModel(const ViewerModel&)> make_viewer_bake() {
+    return [](const ViewerModel& in) {
+        std::unique_ptr<VisibilityTracer> tracer;
+#if defined(SKYBAKE_HAS_CUDA)
+        try {
+            tracer = make_visibility_tracer("cuda", default_trace_method("cuda"));
+        } catch (const Error&) {
+            tracer.reset();
+        }
+#endif
+        if (!tracer)
+            tracer = make_visibility_tracer("embree", default_trace_method("embree"));
+        ViewerModel out = in;
+        TransferOptions t;
+        t.order = 3;
+        BakeOptions b;
+        b.method = tracer->method();
+        const SphereRule rule = parse_rule("lebedev:590");
+        bake_transfer(out.mesh, rule, *tracer, b, t, out.albedo, nullptr, out.transfer);
+        return out;
+    };
+}
 
 double parse_number(const std::string& key, const std::string& value, double lo, double hi) {
     std::size_t used = 0;
@@ -38,12 +72,21 @@ double parse_number(const std::string& key, const std::string& value, double lo,
 }
 
 void run(const ViewModelOpts& o, const CLI::App& sub) {
-    if (o.screenshot.empty())
-        throw UsageError("the window viewer is not available in this build; render an image with --screenshot "
-                         "OUT.png",
-                         "--screenshot");
-    check_output_path(o.screenshot, {".png", ".exr"}, "--screenshot");
+    const bool window = o.screenshot.empty();
+    if (window && !viewer_window_available())
+        throw Error("this build has no window (GLFW or Dear ImGui was not found when it was configured); render an "
+                    "image with --screenshot OUT.png",
+                    "display");
+    if (!window) {
+        check_output_path(o.screenshot, {".png", ".exr"}, "--screenshot");
+        if (o.bake)
+            throw UsageError("--bake is for the window; headless, bake with `skybake prt bake`", "--bake");
+        if (!o.window_capture.empty())
+            throw UsageError("--window-capture is for the window; headless, --screenshot writes the image",
+                             "--window-capture");
+    }
     ModelViewSettings st;
+    bool sky_network = o.model.active();
     parse_flag("--size", [&] { parse_size(o.size, st.camera.width, st.camera.height, "--size"); });
     st.sun_elevation_deg = o.elevation;
     st.sun_azimuth_deg = o.azimuth;
@@ -80,6 +123,22 @@ void run(const ViewModelOpts& o, const CLI::App& sub) {
             if (value != "sky" && value != "none")
                 throw UsageError(fmt::format("background={} is not sky or none", value), "--set");
             st.sky_background = value == "sky";
+        } else if (key == "sky") {
+            if (value != "network" && value != "reference")
+                throw UsageError(fmt::format("sky={} is not network or reference", value), "--set");
+            if (value == "network" && !o.model.active())
+                throw UsageError("sky=network needs a network (--model W.json)", "--set");
+            sky_network = value == "network";
+        } else if (key == "phong") {
+            st.phong_exponent = parse_number(key, value, 0.5, 100000.0);
+        } else if (key == "specular") {
+            st.specular = float(parse_number(key, value, 0.0, 100.0));
+        } else if (key == "shadow") {
+            st.sun_shadow = parse_flag("--set", [&] { return parse_sun_shadow(value); });
+        } else if (key == "direction") {
+            st.visibility_direction = int(parse_number(key, value, 0.0, 1e7));
+        } else if (key == "zoom") {
+            st.zoom = float(parse_number(key, value, 0.01, 100.0));
         } else if (key == "albedo") {
             std::istringstream s(value);
             std::string part;
@@ -89,21 +148,54 @@ void run(const ViewModelOpts& o, const CLI::App& sub) {
                 throw UsageError(fmt::format("albedo={} is not one value or R,G,B in [0, 1]", value), "--set");
         } else {
             throw UsageError(fmt::format("unknown setting '{}'; use exposure, shading, view, fov, samples, sun, "
-                                         "background or albedo",
+                                         "background, sky, phong, specular, shadow, direction, zoom or albedo",
                                          key),
                              "--set");
         }
     }
     const SphereRule rule = parse_flag("--rule", [&] { return parse_rule(o.rule); });
-    const bool neural = o.model.active();
-    const SkySource sky =
-        neural ? SkySource::network(o.model.load(sub, o.atm)) : SkySource::reference(SkyModel(o.atm.load(sub)));
+    if (rule.kind == RuleKind::Phong)
+        throw UsageError(fmt::format("--rule {} is a Phong rule; use a sphere rule (lebedev:2030, ...)", rule.spec),
+                         "--rule");
+    // The network (--model) and the reference sky: that of --preset/--atmosphere, or the network's own tables.
+    std::optional<SkySource> network, reference;
+    if (o.model.active()) {
+        NeuralSky net = o.model.load(sub, o.atm);
+        reference.emplace(SkySource::reference(neural_reference_model(net)));
+        network.emplace(SkySource::network(std::move(net)));
+    } else {
+        reference.emplace(SkySource::reference(SkyModel(o.atm.load(sub))));
+    }
 
     ViewerModel model = load_viewer_model(o.input);
     if (!albedo.empty()) {
         const glm::vec3 a = albedo.size() == 1 ? glm::vec3(albedo[0]) : glm::vec3(albedo[0], albedo[1], albedo[2]);
         std::fill(model.albedo.begin(), model.albedo.end(), a);
     }
+    if (window) {
+        ModelViewerOptions vo;
+        vo.view = st;
+        vo.auto_exposure = auto_exposure;
+        vo.exposure_ev = exposure_ev;
+        vo.frames = o.frames_given ? o.frames : 0;
+        vo.network = network ? &*network : nullptr;
+        vo.reference = &*reference;
+        vo.start_network = sky_network;
+        vo.light_rule = rule;
+        vo.title = fmt::format("skybake view {}", fs::path(o.input).filename().string());
+        vo.bake = make_viewer_bake();
+        vo.screenshot = o.screenshot_path;
+        vo.last_frame = o.window_capture;
+        vo.bake_at_start = o.bake;
+        vo.panel_folded = o.fold_panel;
+        if (!o.window_capture.empty() && !o.frames_given)
+            throw UsageError("--window-capture needs --frames N (the frame it writes is the last)", "--window-capture");
+        if (!o.window_capture.empty())
+            check_output_path(o.window_capture, {".png"}, "--window-capture");
+        run_model_viewer(model, vo); // the panel says when the model has no transfer (and offers to bake one)
+        return;
+    }
+    const SkySource& sky = sky_network ? *network : *reference;
     const int order = model.has_transfer() ? model.transfer.order : 3;
     ModelRenderer renderer(model, sky, rule, order);
     ModelFrameStats stats;
@@ -115,21 +207,8 @@ void run(const ViewModelOpts& o, const CLI::App& sub) {
         img = renderer.render(st, &again);
         draw += again.draw_seconds;
     }
-    if (auto_exposure) {
-        // The 95th percentile luminance (Rec. 709) of the frame maps to 0.6.
-        std::vector<float> lum;
-        for (int y = 0; y < img.height; ++y)
-            for (int x = 0; x < img.width; ++x) {
-                const float* p = img.pixel(x, y);
-                if (const float l = 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2]; l > 0.0f && std::isfinite(l))
-                    lum.push_back(l);
-            }
-        if (!lum.empty()) {
-            const auto k = std::ptrdiff_t(0.95 * double(lum.size() - 1));
-            std::nth_element(lum.begin(), lum.begin() + k, lum.end());
-            exposure_ev = std::log2(0.6f / lum[std::size_t(k)]);
-        }
-    }
+    if (auto_exposure) // the 95th percentile luminance (Rec. 709) of the frame maps to 0.6
+        exposure_ev = model_auto_exposure_ev(img);
     if (lower_extension(o.screenshot) == ".exr") {
         Image scaled = img;
         const float k = std::exp2(exposure_ev);
@@ -162,6 +241,13 @@ void add_view_model(CLI::App& group) {
     group.add_option("input", o->input, "Mesh to view: written by 'prt bake' (with its .prt.json) or any mesh");
     group.add_option("--screenshot", o->screenshot,
                      "Render headless (EGL) to this .png (tone-mapped) or .exr (linear)");
+    group.add_option("--screenshot-path", o->screenshot_path, "In the window: where the P key writes a PNG")
+        ->capture_default_str();
+    group.add_option("--window-capture", o->window_capture,
+                     "In the window with --frames N: write the last frame as shown, panel included (PNG)");
+    group.add_flag("--bake", o->bake,
+                   "In the window: bake the transfer at once when the model has none (as the panel's button)");
+    group.add_flag("--fold-panel", o->fold_panel, "In the window: start with the panel folded");
     group.add_option("--size", o->size, "Image size WxH in pixels")->capture_default_str();
     o->atm.add(group);
     o->model.add(group);
@@ -174,19 +260,23 @@ void add_view_model(CLI::App& group) {
     group.add_option("--altitude-km", o->altitude, "Observer above the ground, km")
         ->check(real_in(0.0, 1e6, "km"))
         ->capture_default_str();
-    group.add_option("--frames", o->frames, "Frames to draw (the last is written); prints the mean frame time")
+    group.add_option("--frames", o->frames,
+                     "Frames to draw (the last is written); prints the mean frame time. In the window: close "
+                     "after N frames")
         ->check(integer_in(1, 100000))
         ->capture_default_str();
     group.add_option("--rule", o->rule, "Sphere rule of the sky's SH projection")->capture_default_str();
     group.add_option("--set", o->set,
-                     "key=value: exposure=EV|auto, shading=prt|ao|a|unshadowed, view=AZ,EL, fov=DEG, samples=N, "
-                     "sun=on|off, background=sky|none, albedo=A|R,G,B");
+                     "key=value: exposure=EV|auto, shading=prt|ao|a|unshadowed|dprt|visibility, view=AZ,EL, fov=DEG, "
+                     "samples=N, sun=on|off, background=sky|none, sky=network|reference, phong=A, specular=K, "
+                     "shadow=map|vertex|none, direction=K, zoom=F, albedo=A|R,G,B");
     group.callback([o, &group] {
         if (group.get_subcommands().empty()) {
             if (o->input.empty())
                 throw UsageError("give a mesh to view (skybake view MODEL.glb --screenshot OUT.png) or a sub-command "
                                  "(skybake view planet)",
                                  "input");
+            o->frames_given = group.count("--frames") > 0;
             run(*o, group);
         }
     });

@@ -9,7 +9,7 @@ namespace skybake::cli {
 void add_view_planet(CLI::App& group) {
     auto* sub = group.add_subcommand("planet", "Fly around the planet in a window: drag to look, W/A/S/D/R/F to "
                                                "move (speed follows the altitude, Shift x10), arrows move the sun, "
-                                               "V per-vertex/per-pixel, +/- exposure, Esc quits");
+                                               "V per-vertex/per-pixel, +/- exposure, P screenshot, Esc quits");
     struct Opts {
         ModelFlag model;
         ViewerOptions v;
@@ -32,6 +32,10 @@ void add_view_planet(CLI::App& group) {
     sub->add_option("--exposure", o->v.exposure_ev, "Starting exposure, stops")
         ->check(real_in(-64.0, 64.0, "stops"))
         ->capture_default_str();
+    sub->add_option("--frames", o->v.frames, "Close after N frames (0: run until closed)")
+        ->check(integer_in(0, 100000000))
+        ->capture_default_str();
+    sub->add_option("--screenshot-path", o->v.screenshot, "Where the P key writes a PNG")->capture_default_str();
     sub->add_option("--sky", o->sky, "network, or reference (the seed's sum in GLSL)")->capture_default_str();
     sub->add_option("--ground", o->ground, "Ground model: lambert (physical) or as-published (the paper's b-scaled term; also: seed)")
         ->capture_default_str();

@@ -117,9 +117,12 @@ struct ViewerOptions {
     double altitude_km = 0.002;
     double sun_elevation_deg = 20.0, sun_azimuth_deg = 0.0;
     double exposure_ev = 0.0; // initial exposure, stops
+    int frames = 0;           // > 0: close after this many frames (tests)
+    std::string screenshot = "skybake_planet.png"; // where the screenshot key (P) writes
 };
-// Opens a GLFW window and runs until it is closed. Throws skybake::Error when
-// no display can be opened (one line, naming "display").
+// Opens a GLFW window with a Dear ImGui panel and runs until it is closed.
+// Throws skybake::Error when no display can be opened or the build has no
+// window (one line, naming "display").
 void run_planet_viewer(const SkyModel& tables, const NeuralSky* net, const ViewerOptions& options);
 
 } // namespace skybake
