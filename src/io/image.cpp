@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 
 #include <fmt/format.h>
@@ -222,6 +223,23 @@ void check_jpeg_huffman_tables(const unsigned char* d, std::size_t size, const s
     }
 }
 
+// stb_image allocates a PNG chunk's stated length before it reads the chunk:
+// a 70-byte file that says its IDAT holds 1.4 GB allocates 1.4 GB. Every
+// chunk must fit in the file.
+void check_png_chunks(const unsigned char* d, std::size_t size, const std::string& name) {
+    std::size_t i = 8; // after the signature
+    while (i + 8 <= size) {
+        const std::uint64_t length = std::uint64_t(d[i]) << 24 | std::uint64_t(d[i + 1]) << 16 |
+                                     std::uint64_t(d[i + 2]) << 8 | std::uint64_t(d[i + 3]);
+        if (length + 12 > size - i)
+            throw Error(fmt::format("truncated PNG: a chunk of {} bytes at byte {} of a file of {}", length, i, size),
+                        name);
+        if (std::memcmp(d + i + 4, "IEND", 4) == 0)
+            return;
+        i += std::size_t(length) + 12;
+    }
+}
+
 Image load_exr_from_memory(const unsigned char* data, std::size_t size, const std::string& name,
                            std::uint64_t max_pixels) {
     // The header first: its data window says how much LoadEXRFromMemory allocates.
@@ -277,12 +295,26 @@ Image load_image_from_memory(const void* data, std::size_t size, const std::stri
         throw Error(fmt::format("an image file of {} bytes is too large", size), name);
     if (size >= 2 && bytes[0] == 0xFF && bytes[1] == 0xD8)
         check_jpeg_huffman_tables(bytes, size, name);
+    if (size >= 8 && std::memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0)
+        check_png_chunks(bytes, size, name);
     int w = 0, h = 0, comp = 0;
     // The header first: stb_image allocates what it says before reading the pixels.
     if (!stbi_info_from_memory(bytes, int(size), &w, &h, &comp))
         throw Error(fmt::format("cannot decode image: {}", stbi_failure_reason()), name);
     check_pixels(w, h, max_pixels, f == "hdr" ? "Radiance HDR" : "the", name);
     if (f == "hdr") { // Radiance RGBE: linear radiance
+        // stb_image reads the pixels of a truncated file as zeros: a header
+        // alone would be a black map of any size. Each scanline takes at
+        // least 4 bytes a pixel, or run-length encoded 4 bytes and 2 per run
+        // of up to 127 pixels in each of 4 channels (8 to 32767 pixels wide).
+        const std::uint64_t flat = 4 * std::uint64_t(w);
+        const std::uint64_t rle = w >= 8 && w < 32768 ? 4 + 8 * ((std::uint64_t(w) + 126) / 127) : flat;
+        const std::uint64_t least = std::uint64_t(h) * std::min(flat, rle);
+        if (size < least)
+            throw Error(fmt::format("truncated Radiance HDR image: {} x {} pixels take at least {} bytes; the file "
+                                    "has {}",
+                                    w, h, least, size),
+                        name);
         float* px = stbi_loadf_from_memory(bytes, int(size), &w, &h, &comp, 3);
         if (!px)
             throw Error(fmt::format("cannot decode Radiance HDR image: {}", stbi_failure_reason()), name);

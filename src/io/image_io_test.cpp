@@ -77,6 +77,13 @@ TEST(ImageFiles, AHugeHeaderIsAnErrorNotAnAllocation) {
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("larger than the limit"), std::string::npos) << e.what();
     }
+    const std::string truncated = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4096 +X 8192\n";
+    try {
+        load_image_from_memory(truncated.data(), truncated.size(), "hdr", "truncated.hdr");
+        FAIL() << "a header without pixels was read as a black map";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
+    }
     const Image small = gradient(8, 4);
     save_image(temp("small.exr"), small);
     std::ifstream in(temp("small.exr"), std::ios::binary);
