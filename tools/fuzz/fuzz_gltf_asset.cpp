@@ -25,6 +25,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     static const fs::path dir = [] {
         const fs::path d = fs::temp_directory_path() / ("skybake-fuzz-gltf-asset-" + std::to_string(getpid()));
         fs::create_directories(d);
+        std::atexit([] {
+            std::error_code ec;
+            fs::remove_all(fs::temp_directory_path() / ("skybake-fuzz-gltf-asset-" + std::to_string(getpid())), ec);
+        });
         return d;
     }();
     const std::string ext = data[0] % 2 ? ".glb" : ".gltf";
