@@ -183,9 +183,12 @@ void check_pixels(std::int64_t w, std::int64_t h, std::uint64_t max_pixels, cons
 
 // Debian's stb_image (2.27) builds a JPEG Huffman table of as many codes as
 // the 16 counts of its DHT segment add up to, into arrays of 256: a corrupt
-// table writes past them. Every DHT table is checked here first, read as
-// stb_image reads it (tables follow each other by their own sizes).
+// table writes past them. And a scan that uses a table no DHT defined yet
+// decodes with uninitialised memory, reading past the table. Every DHT table
+// is checked here first, read as stb_image reads it (tables follow each other
+// by their own sizes), and every scan's tables must be defined before it.
 void check_jpeg_huffman_tables(const unsigned char* d, std::size_t size, const std::string& name) {
+    bool defined[2][16] = {};
     std::size_t i = 2; // after SOI
     while (i + 1 < size) {
         if (d[i] != 0xFF) {
@@ -215,8 +218,22 @@ void check_jpeg_huffman_tables(const unsigned char* d, std::size_t size, const s
                     throw Error(fmt::format("cannot decode image: corrupt JPEG (a Huffman table of {} codes; at most 256)",
                                             n),
                                 name);
+                defined[d[p] >> 4 & 1][d[p] & 15] = true;
                 p += 17 + n;
                 left -= long(17 + n);
+            }
+        }
+        if (m == 0xDA && i + 5 <= size) { // SOS: components, then Ss, Se, Ah|Al
+            const std::size_t components = d[i + 4], o = i + 5 + 2 * components;
+            if (o + 3 > size)
+                return;
+            const unsigned ss = d[o], se = d[o + 1], ah = d[o + 2] >> 4;
+            for (std::size_t c = 0; c < components; ++c) {
+                const unsigned td = d[i + 6 + 2 * c] >> 4, ta = d[i + 6 + 2 * c] & 15;
+                if ((ss == 0 && ah == 0 && !defined[0][td]) || (se > 0 && !defined[1][ta]))
+                    throw Error(fmt::format("cannot decode image: corrupt JPEG (a scan uses a Huffman table that "
+                                            "no DHT segment defines before it)"),
+                                name);
             }
         }
         i += 2 + length;

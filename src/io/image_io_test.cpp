@@ -93,8 +93,9 @@ TEST(ImageFiles, AHugeHeaderIsAnErrorNotAnAllocation) {
 }
 
 // stb_image 2.27 builds a JPEG Huffman table of as many codes as its counts
-// add up to, into arrays of 256: such a table is refused before stb reads it.
-TEST(ImageFiles, AJpegHuffmanTableOfOver256CodesIsAnError) {
+// add up to, into arrays of 256, and decodes a scan with a table that was never
+// defined: both are refused before stb reads them.
+TEST(ImageFiles, CorruptJpegHuffmanTablesAreErrors) {
     std::string jpeg = "\xFF\xD8\xFF\xC4";
     jpeg += std::string("\x00\x13\x00", 3);     // length 19: one table, class 0, id 0
     jpeg += std::string(16, '\x20');             // 16 counts of 32: 512 codes
@@ -104,6 +105,16 @@ TEST(ImageFiles, AJpegHuffmanTableOfOver256CodesIsAnError) {
         FAIL() << "a Huffman table of 512 codes was accepted";
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("Huffman table of 512 codes"), std::string::npos) << e.what();
+    }
+    // A scan that uses tables no DHT defined: stb_image 2.27 decodes with uninitialised tables.
+    std::string scan = "\xFF\xD8\xFF\xDA";
+    scan += std::string("\x00\x08\x01\x01\x00\x00\x3F\x00", 8); // one component, tables 0/0, Ss 0, Se 63
+    scan += std::string(64, '\x55') + "\xFF\xD9";
+    try {
+        load_image_from_memory(scan.data(), scan.size(), "jpg", "bad.jpg");
+        FAIL() << "a scan without Huffman tables was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("no DHT segment defines"), std::string::npos) << e.what();
     }
 }
 
