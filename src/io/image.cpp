@@ -242,9 +242,10 @@ void check_jpeg_huffman_tables(const unsigned char* d, std::size_t size, const s
 
 // stb_image allocates a PNG chunk's stated length before it reads the chunk:
 // a 70-byte file that says its IDAT holds 1.4 GB allocates 1.4 GB. Every
-// chunk must fit in the file.
+// chunk must fit in the file, and the first IDAT must not be empty.
 void check_png_chunks(const unsigned char* d, std::size_t size, const std::string& name) {
     std::size_t i = 8; // after the signature
+    bool image_data = false;
     while (i + 8 <= size) {
         const std::uint64_t length = std::uint64_t(d[i]) << 24 | std::uint64_t(d[i + 1]) << 16 |
                                      std::uint64_t(d[i + 2]) << 8 | std::uint64_t(d[i + 3]);
@@ -253,6 +254,12 @@ void check_png_chunks(const unsigned char* d, std::size_t size, const std::strin
                         name);
         if (std::memcmp(d + i + 4, "IEND", 4) == 0)
             return;
+        // stb_image copies an empty first IDAT to a null buffer (memcpy(nullptr, p, 0)).
+        if (std::memcmp(d + i + 4, "IDAT", 4) == 0) {
+            if (length == 0 && !image_data)
+                throw Error("PNG with an empty IDAT chunk before the image data: not supported", name);
+            image_data = true;
+        }
         i += std::size_t(length) + 12;
     }
 }
