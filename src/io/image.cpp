@@ -210,10 +210,10 @@ void check_jpeg_huffman_tables(const unsigned char* d, std::size_t size, const s
         if (m == 0xC4) {
             long left = long(length) - 2;
             std::size_t p = i + 4;
-            while (left > 0 && p + 17 <= size) {
-                std::size_t n = 0;
-                for (int k = 1; k <= 16; ++k)
-                    n += d[p + std::size_t(k)];
+            while (left > 0 && p < size) {
+                std::size_t n = 0; // stb_image reads bytes past the end as zeros
+                for (std::size_t k = 1; k <= 16; ++k)
+                    n += p + k < size ? d[p + k] : 0;
                 if (n > 256)
                     throw Error(fmt::format("cannot decode image: corrupt JPEG (a Huffman table of {} codes; at most 256)",
                                             n),
