@@ -23,6 +23,7 @@
 #include <functional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/mat3x3.hpp>
@@ -339,6 +340,9 @@ std::string transfer_sidecar_json(const Transfer& transfer, std::size_t vertices
 std::string light_json(const ShLight& light, const std::string& source, const std::string& rule);
 // Throws skybake::Error (where: "light") for a missing, corrupt or inconsistent file.
 ShLight load_light(const std::filesystem::path& path);
+// The same from the file's text (what load_light() reads); `name` stands for
+// the file in error messages. Integer fields must be JSON integers.
+ShLight light_from_json(std::string_view text, const std::string& name);
 
 struct PrtModel {
     Mesh mesh;
@@ -349,5 +353,10 @@ struct PrtModel {
 // "sidecar") for a missing, corrupt or mismatched sidecar (wrong format,
 // order, vertex count or attributes).
 PrtModel load_prt(const std::filesystem::path& mesh_path);
+// What load_prt() does once both are read: the sidecar's text checked and
+// then applied to `mesh` (its prt_N, albedo and shading attributes). The names
+// stand for the two files in error messages; throws as load_prt() does.
+PrtModel prt_from_sidecar_json(std::string_view sidecar, Mesh mesh, const std::string& sidecar_name,
+                               const std::string& mesh_name);
 
 } // namespace skybake

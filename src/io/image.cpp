@@ -3,8 +3,11 @@
 #include "skybake/image.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 
 #include <fmt/format.h>
@@ -167,49 +170,202 @@ void save_image(const fs::path& path, const Image& image, const ToneMap& tm) {
         throw Error(fmt::format("unknown image extension '{}'; use .png or .exr", ext), path.string());
 }
 
+namespace {
+
+void check_pixels(std::int64_t w, std::int64_t h, std::uint64_t max_pixels, const char* what, const std::string& name) {
+    if (w <= 0 || h <= 0)
+        throw Error(fmt::format("{} image of {} x {} pixels", what, w, h), name);
+    if (std::uint64_t(w) * std::uint64_t(h) > max_pixels)
+        throw Error(fmt::format("{} image of {} x {} pixels is larger than the limit of {} pixels", what, w, h,
+                                max_pixels),
+                    name);
+}
+
+// Debian's stb_image (2.27) builds a JPEG Huffman table of as many codes as
+// the 16 counts of its DHT segment add up to, into arrays of 256: a corrupt
+// table writes past them. And a scan that uses a table no DHT defined yet
+// decodes with uninitialised memory, reading past the table. Every DHT table
+// is checked here first, read as stb_image reads it (tables follow each other
+// by their own sizes), and every scan's tables must be defined before it.
+void check_jpeg_huffman_tables(const unsigned char* d, std::size_t size, const std::string& name) {
+    bool defined[2][16] = {};
+    std::size_t i = 2; // after SOI
+    while (i + 1 < size) {
+        if (d[i] != 0xFF) {
+            ++i; // entropy-coded data
+            continue;
+        }
+        const unsigned m = d[i + 1];
+        if (m == 0xFF) {
+            ++i; // fill byte
+            continue;
+        }
+        if (m == 0x00 || m == 0x01 || (m >= 0xD0 && m <= 0xD8)) {
+            i += 2; // stuffing, TEM, RSTn, SOI: no length
+            continue;
+        }
+        if (m == 0xD9 || i + 4 > size)
+            return; // EOI
+        const std::size_t length = std::size_t(d[i + 2]) << 8 | d[i + 3];
+        if (m == 0xC4) {
+            long left = long(length) - 2;
+            std::size_t p = i + 4;
+            while (left > 0 && p < size) {
+                std::size_t n = 0; // stb_image reads bytes past the end as zeros
+                for (std::size_t k = 1; k <= 16; ++k)
+                    n += p + k < size ? d[p + k] : 0;
+                if (n > 256)
+                    throw Error(fmt::format("cannot decode image: corrupt JPEG (a Huffman table of {} codes; at most 256)",
+                                            n),
+                                name);
+                defined[d[p] >> 4 & 1][d[p] & 15] = true;
+                p += 17 + n;
+                left -= long(17 + n);
+            }
+        }
+        if (m == 0xDA && i + 5 <= size) { // SOS: components, then Ss, Se, Ah|Al
+            const std::size_t components = d[i + 4], o = i + 5 + 2 * components;
+            if (o + 3 > size)
+                return;
+            const unsigned ss = d[o], se = d[o + 1], ah = d[o + 2] >> 4;
+            for (std::size_t c = 0; c < components; ++c) {
+                const unsigned td = d[i + 6 + 2 * c] >> 4, ta = d[i + 6 + 2 * c] & 15;
+                if ((ss == 0 && ah == 0 && !defined[0][td]) || (se > 0 && !defined[1][ta]))
+                    throw Error(fmt::format("cannot decode image: corrupt JPEG (a scan uses a Huffman table that "
+                                            "no DHT segment defines before it)"),
+                                name);
+            }
+        }
+        i += 2 + length;
+    }
+}
+
+// stb_image allocates a PNG chunk's stated length before it reads the chunk:
+// a 70-byte file that says its IDAT holds 1.4 GB allocates 1.4 GB. Every
+// chunk must fit in the file, and the first IDAT must not be empty.
+void check_png_chunks(const unsigned char* d, std::size_t size, const std::string& name) {
+    std::size_t i = 8; // after the signature
+    bool image_data = false;
+    while (i + 8 <= size) {
+        const std::uint64_t length = std::uint64_t(d[i]) << 24 | std::uint64_t(d[i + 1]) << 16 |
+                                     std::uint64_t(d[i + 2]) << 8 | std::uint64_t(d[i + 3]);
+        if (length + 12 > size - i)
+            throw Error(fmt::format("truncated PNG: a chunk of {} bytes at byte {} of a file of {}", length, i, size),
+                        name);
+        if (std::memcmp(d + i + 4, "IEND", 4) == 0)
+            return;
+        // stb_image copies an empty first IDAT to a null buffer (memcpy(nullptr, p, 0)).
+        if (std::memcmp(d + i + 4, "IDAT", 4) == 0) {
+            if (length == 0 && !image_data)
+                throw Error("PNG with an empty IDAT chunk before the image data: not supported", name);
+            image_data = true;
+        }
+        i += std::size_t(length) + 12;
+    }
+}
+
+Image load_exr_from_memory(const unsigned char* data, std::size_t size, const std::string& name,
+                           std::uint64_t max_pixels) {
+    // The header first: its data window says how much LoadEXRFromMemory allocates.
+    EXRVersion version;
+    if (ParseEXRVersionFromMemory(&version, data, size) != TINYEXR_SUCCESS)
+        throw Error("cannot read EXR: not an OpenEXR file", name);
+    if (version.multipart || version.non_image)
+        throw Error("cannot read EXR: multi-part and deep images are not supported", name);
+    EXRHeader header;
+    InitEXRHeader(&header);
+    const char* err = nullptr;
+    if (ParseEXRHeaderFromMemory(&header, &version, data, size, &err) != TINYEXR_SUCCESS) {
+        const std::string msg = err ? err : "unknown tinyexr error";
+        if (err)
+            FreeEXRErrorMessage(err);
+        throw Error(fmt::format("cannot read EXR: {}", msg), name);
+    }
+    const std::int64_t w = std::int64_t(header.data_window.max_x) - header.data_window.min_x + 1;
+    const std::int64_t h = std::int64_t(header.data_window.max_y) - header.data_window.min_y + 1;
+    FreeEXRHeader(&header);
+    check_pixels(w, h, max_pixels, "EXR", name);
+    float* rgba = nullptr;
+    int iw = 0, ih = 0;
+    if (LoadEXRFromMemory(&rgba, &iw, &ih, data, size, &err) != TINYEXR_SUCCESS) {
+        const std::string msg = err ? err : "unknown tinyexr error";
+        if (err)
+            FreeEXRErrorMessage(err);
+        throw Error(fmt::format("cannot read EXR: {}", msg), name);
+    }
+    std::unique_ptr<float, decltype(&std::free)> guard(rgba, &std::free);
+    check_pixels(iw, ih, max_pixels, "EXR", name);
+    Image img(iw, ih);
+    for (std::size_t i = 0; i < std::size_t(iw) * std::size_t(ih); ++i)
+        for (int c = 0; c < 3; ++c)
+            img.rgb[i * 3 + std::size_t(c)] = rgba[i * 4 + std::size_t(c)];
+    return img;
+}
+
+} // namespace
+
+Image load_image_from_memory(const void* data, std::size_t size, const std::string& format, const std::string& name,
+                             std::uint64_t max_pixels) {
+    std::string f = format;
+    std::transform(f.begin(), f.end(), f.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    if (!f.empty() && f[0] == '.')
+        f.erase(0, 1);
+    if (size == 0)
+        throw Error("the image file is empty", name);
+    const auto* bytes = static_cast<const unsigned char*>(data);
+    if (f == "exr")
+        return load_exr_from_memory(bytes, size, name, max_pixels);
+    if (size > std::size_t(INT_MAX))
+        throw Error(fmt::format("an image file of {} bytes is too large", size), name);
+    if (size >= 2 && bytes[0] == 0xFF && bytes[1] == 0xD8)
+        check_jpeg_huffman_tables(bytes, size, name);
+    if (size >= 8 && std::memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0)
+        check_png_chunks(bytes, size, name);
+    int w = 0, h = 0, comp = 0;
+    // The header first: stb_image allocates what it says before reading the pixels.
+    if (!stbi_info_from_memory(bytes, int(size), &w, &h, &comp))
+        throw Error(fmt::format("cannot decode image: {}", stbi_failure_reason()), name);
+    check_pixels(w, h, max_pixels, f == "hdr" ? "Radiance HDR" : "the", name);
+    if (f == "hdr") { // Radiance RGBE: linear radiance
+        // stb_image reads the pixels of a truncated file as zeros: a header
+        // alone would be a black map of any size. Each scanline takes at
+        // least 4 bytes a pixel, or run-length encoded 4 bytes and 2 per run
+        // of up to 127 pixels in each of 4 channels (8 to 32767 pixels wide).
+        const std::uint64_t flat = 4 * std::uint64_t(w);
+        const std::uint64_t rle = w >= 8 && w < 32768 ? 4 + 8 * ((std::uint64_t(w) + 126) / 127) : flat;
+        const std::uint64_t least = std::uint64_t(h) * std::min(flat, rle);
+        if (size < least)
+            throw Error(fmt::format("truncated Radiance HDR image: {} x {} pixels take at least {} bytes; the file "
+                                    "has {}",
+                                    w, h, least, size),
+                        name);
+        float* px = stbi_loadf_from_memory(bytes, int(size), &w, &h, &comp, 3);
+        if (!px)
+            throw Error(fmt::format("cannot decode Radiance HDR image: {}", stbi_failure_reason()), name);
+        std::unique_ptr<float, void (*)(void*)> guard(px, stbi_image_free);
+        check_pixels(w, h, max_pixels, "Radiance HDR", name);
+        Image img(w, h);
+        std::copy(px, px + img.rgb.size(), img.rgb.begin());
+        return img;
+    }
+    unsigned char* px = stbi_load_from_memory(bytes, int(size), &w, &h, &comp, 3);
+    if (!px)
+        throw Error(fmt::format("cannot decode image: {}", stbi_failure_reason()), name);
+    std::unique_ptr<unsigned char, void (*)(void*)> guard(px, stbi_image_free);
+    check_pixels(w, h, max_pixels, "the", name);
+    Image img(w, h);
+    for (std::size_t i = 0; i < img.rgb.size(); ++i)
+        img.rgb[i] = srgb_to_linear(float(px[i]) / 255.0f);
+    return img;
+}
+
 Image load_image(const fs::path& path) {
     const std::string ext = lower_extension(path);
     std::error_code ec;
     if (!fs::exists(path, ec))
         throw Error("file not found", path.string());
-    if (ext == ".exr") {
-        float* rgba = nullptr;
-        int w = 0, h = 0;
-        const char* err = nullptr;
-        if (LoadEXR(&rgba, &w, &h, path.c_str(), &err) != TINYEXR_SUCCESS) {
-            std::string msg = err ? err : "unknown tinyexr error";
-            if (err)
-                FreeEXRErrorMessage(err);
-            throw Error(fmt::format("cannot read EXR: {}", msg), path.string());
-        }
-        std::unique_ptr<float, decltype(&std::free)> guard(rgba, &std::free);
-        Image img(w, h);
-        for (std::size_t i = 0; i < std::size_t(w) * std::size_t(h); ++i)
-            for (int c = 0; c < 3; ++c)
-                img.rgb[i * 3 + std::size_t(c)] = rgba[i * 4 + std::size_t(c)];
-        return img;
-    }
     const std::string data = read_file(path, std::uint64_t(1) << 30);
-    int w = 0, h = 0, comp = 0;
-    if (ext == ".hdr") { // Radiance RGBE: linear radiance
-        float* f = stbi_loadf_from_memory(reinterpret_cast<const stbi_uc*>(data.data()), int(data.size()), &w, &h,
-                                          &comp, 3);
-        if (!f)
-            throw Error(fmt::format("cannot decode Radiance HDR image: {}", stbi_failure_reason()), path.string());
-        std::unique_ptr<float, void (*)(void*)> guard(f, stbi_image_free);
-        Image img(w, h);
-        std::copy(f, f + img.rgb.size(), img.rgb.begin());
-        return img;
-    }
-    unsigned char* px = stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(data.data()), int(data.size()), &w,
-                                              &h, &comp, 3);
-    if (!px)
-        throw Error(fmt::format("cannot decode image: {}", stbi_failure_reason()), path.string());
-    std::unique_ptr<unsigned char, void (*)(void*)> guard(px, stbi_image_free);
-    Image img(w, h);
-    for (std::size_t i = 0; i < img.rgb.size(); ++i)
-        img.rgb[i] = srgb_to_linear(float(px[i]) / 255.0f);
-    return img;
+    return load_image_from_memory(data.data(), data.size(), ext, path.string());
 }
 
 } // namespace skybake

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <string>
 
 #include <gtest/gtest.h>
 
@@ -62,6 +64,58 @@ TEST(ImageFiles, BadPathsAndExtensions) {
     const fs::path junk = temp("junk.png");
     { std::ofstream(junk) << "not a png"; }
     EXPECT_THROW(load_image(junk), Error);
+}
+
+// A few header bytes must not make the loader allocate what they claim: a
+// Radiance header of 16000 x 16000 pixels and no pixel data (stb_image would
+// allocate 3 GiB and fill it with zeros) is refused before any allocation.
+TEST(ImageFiles, AHugeHeaderIsAnErrorNotAnAllocation) {
+    const std::string hdr = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 16000 +X 16000\n";
+    try {
+        load_image_from_memory(hdr.data(), hdr.size(), "hdr", "huge.hdr");
+        FAIL() << "a 256-Mpixel header was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("larger than the limit"), std::string::npos) << e.what();
+    }
+    const std::string truncated = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 4096 +X 8192\n";
+    try {
+        load_image_from_memory(truncated.data(), truncated.size(), "hdr", "truncated.hdr");
+        FAIL() << "a header without pixels was read as a black map";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("truncated"), std::string::npos) << e.what();
+    }
+    const Image small = gradient(8, 4);
+    save_image(temp("small.exr"), small);
+    std::ifstream in(temp("small.exr"), std::ios::binary);
+    const std::string exr((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(load_image_from_memory(exr.data(), exr.size(), ".EXR", "small.exr").width, 8);
+    EXPECT_THROW(load_image_from_memory(exr.data(), exr.size(), "exr", "small.exr", 31), Error);
+}
+
+// stb_image 2.27 builds a JPEG Huffman table of as many codes as its counts
+// add up to, into arrays of 256, and decodes a scan with a table that was never
+// defined: both are refused before stb reads them.
+TEST(ImageFiles, CorruptJpegHuffmanTablesAreErrors) {
+    std::string jpeg = "\xFF\xD8\xFF\xC4";
+    jpeg += std::string("\x00\x13\x00", 3);     // length 19: one table, class 0, id 0
+    jpeg += std::string(16, '\x20');             // 16 counts of 32: 512 codes
+    jpeg += std::string(512, '\x01') + "\xFF\xD9";
+    try {
+        load_image_from_memory(jpeg.data(), jpeg.size(), "jpg", "bad.jpg");
+        FAIL() << "a Huffman table of 512 codes was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("Huffman table of 512 codes"), std::string::npos) << e.what();
+    }
+    // A scan that uses tables no DHT defined: stb_image 2.27 decodes with uninitialised tables.
+    std::string scan = "\xFF\xD8\xFF\xDA";
+    scan += std::string("\x00\x08\x01\x01\x00\x00\x3F\x00", 8); // one component, tables 0/0, Ss 0, Se 63
+    scan += std::string(64, '\x55') + "\xFF\xD9";
+    try {
+        load_image_from_memory(scan.data(), scan.size(), "jpg", "bad.jpg");
+        FAIL() << "a scan without Huffman tables was accepted";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("no DHT segment defines"), std::string::npos) << e.what();
+    }
 }
 
 TEST(ToneMap, SrgbTransferInverts) {

@@ -1,6 +1,9 @@
 // A baked mesh's transfer: vec4 attributes "prt_0", ... and the JSON sidecar
 // that says how to read them (skybake/prt.h, [SECTION] Files).
+#include <climits>
 #include <cmath>
+#include <cstdint>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -18,6 +21,97 @@ constexpr int kVersion = 1;
 
 int attribute_count(const Transfer& t) {
     return (t.channels * t.coefficients + 3) / 4;
+}
+
+// An integer field, refused (a JSON type error) when it is not an integer
+// that fits in an int: get<int>() of 1e300 or 2^40 would not be defined.
+int json_int(const nlohmann::json& v, const char* field) {
+    if (!v.is_number_integer() || (v.is_number_unsigned() && v.get<std::uint64_t>() > std::uint64_t(INT_MAX)) ||
+        (!v.is_number_unsigned() && (v.get<std::int64_t>() < INT_MIN || v.get<std::int64_t>() > INT_MAX)))
+        throw nlohmann::json::type_error::create(302, fmt::format("{} must be an integer, not {}", field, v.dump()),
+                                                 &v);
+    return v.get<int>();
+}
+
+struct SidecarHeader {
+    Transfer transfer; // without coefficients
+    std::size_t vertices = 0;
+};
+
+// The sidecar's own checks, before its mesh is read.
+SidecarHeader parse_sidecar(std::string_view text, const std::string& side) {
+    nlohmann::json j;
+    try {
+        j = nlohmann::json::parse(text);
+    } catch (const nlohmann::json::exception& e) {
+        throw Error(fmt::format("{} is not valid JSON: {}", side, e.what()), "sidecar");
+    }
+    SidecarHeader h;
+    Transfer& t = h.transfer;
+    try {
+        if (!j.is_object() || j.value("format", "") != kFormat)
+            throw Error(fmt::format("{} is not a skybake-prt sidecar", side), "sidecar");
+        if (json_int(j.at("version"), "version") != kVersion)
+            throw Error(fmt::format("{}: version {} is not {}", side, j.at("version").dump(), kVersion), "sidecar");
+        t.order = json_int(j.at("order"), "order");
+        t.coefficients = json_int(j.at("coefficients"), "coefficients");
+        t.channels = json_int(j.at("channels"), "channels");
+        t.kind = parse_transfer_kind(j.at("kind").get<std::string>());
+        t.model = parse_transfer_model(j.at("model").get<std::string>());
+        t.bounces = json_int(j.at("bounces"), "bounces");
+        t.rule = j.at("rule").get<std::string>();
+        const nlohmann::json& n = j.at("vertices");
+        if (!n.is_number_unsigned())
+            throw nlohmann::json::type_error::create(302, "vertices must be a count, not " + n.dump(), &n);
+        h.vertices = n.get<std::size_t>();
+    } catch (const nlohmann::json::exception& e) {
+        throw Error(fmt::format("{}: missing or wrong field ({})", side, e.what()), "sidecar");
+    } catch (const Error& e) {
+        throw Error(fmt::format("{}: {}", side, e.message()), "sidecar");
+    }
+    if (t.order < 0 || t.order > kPrtMaxOrder || t.coefficients != sh_count(t.order) ||
+        (t.channels != 1 && t.channels != 3))
+        throw Error(fmt::format("{}: order {}, {} coefficients and {} channels do not fit together", side, t.order,
+                                t.coefficients, t.channels),
+                    "sidecar");
+    return h;
+}
+
+// The mesh's attributes read through the sidecar.
+PrtModel attach_transfer(SidecarHeader h, Mesh mesh, const std::string& side, const std::string& mesh_name) {
+    PrtModel m;
+    m.mesh = std::move(mesh);
+    m.transfer = std::move(h.transfer);
+    Transfer& t = m.transfer;
+    const std::size_t n = m.mesh.vertex_count();
+    if (n != h.vertices)
+        throw Error(fmt::format("{} describes {} vertices but {} has {}", side, h.vertices, mesh_name, n), "sidecar");
+    const int per_vertex = t.channels * t.coefficients;
+    t.coeffs.assign(n * std::size_t(per_vertex), 0.0f);
+    for (int a = 0; a < attribute_count(t); ++a) {
+        const std::string name = fmt::format("prt_{}", a);
+        const VertexAttribute* attr = m.mesh.find_attribute(name);
+        if (!attr || attr->components != 4 || attr->values.size() != 4 * n)
+            throw Error(fmt::format("{} has no 4-component attribute {} that {} lists", mesh_name, name, side),
+                        "sidecar");
+        for (std::size_t v = 0; v < n; ++v)
+            for (int k = 0; k < 4; ++k)
+                if (4 * a + k < per_vertex)
+                    t.coeffs[v * std::size_t(per_vertex) + std::size_t(4 * a + k)] =
+                        attr->values[4 * v + std::size_t(k)];
+    }
+    const VertexAttribute* alb = m.mesh.find_attribute("albedo");
+    if (!alb || alb->components != 3 || alb->values.size() != 3 * n)
+        throw Error(fmt::format("{} has no 3-component albedo attribute", mesh_name), "sidecar");
+    m.albedo.resize(n);
+    for (std::size_t v = 0; v < n; ++v)
+        m.albedo[v] = {alb->values[3 * v], alb->values[3 * v + 1], alb->values[3 * v + 2]};
+    if (const VertexAttribute* a = m.mesh.find_attribute("shading"); a && a->components == 1 && a->values.size() == n)
+        t.shading = a->values;
+    for (float x : t.coeffs)
+        if (!std::isfinite(x))
+            throw Error(fmt::format("{} has non-finite transfer coefficients", mesh_name), "sidecar");
+    return m;
 }
 
 } // namespace
@@ -90,24 +184,27 @@ std::string light_json(const ShLight& light, const std::string& source, const st
     return j.dump(1) + "\n";
 }
 
-ShLight load_light(const std::filesystem::path& path) {
+ShLight light_from_json(std::string_view text, const std::string& name) {
     ShLight l;
     try {
-        const nlohmann::json j = nlohmann::json::parse(read_file(path, std::uint64_t(64) << 20));
-        if (!j.is_object() || j.value("format", "") != "skybake-sh-light" || j.at("version").get<int>() != 1)
-            throw Error(fmt::format("{} is not a skybake-sh-light file (version 1)", path.string()), "light");
-        l.order = j.at("order").get<int>();
+        const nlohmann::json j = nlohmann::json::parse(text);
+        if (!j.is_object() || j.value("format", "") != "skybake-sh-light" || !j.contains("version") ||
+            json_int(j.at("version"), "version") != 1)
+            throw Error(fmt::format("{} is not a skybake-sh-light file (version 1)", name), "light");
+        l.order = json_int(j.at("order"), "order");
         if (l.order < 0 || l.order > kShMaxL)
-            throw Error(fmt::format("{}: order {} is out of range", path.string(), l.order), "light");
+            throw Error(fmt::format("{}: order {} is out of range", name, l.order), "light");
         const auto& c = j.at("coefficients");
         if (!c.is_array() || c.size() != std::size_t(sh_count(l.order)))
-            throw Error(fmt::format("{}: order {} needs {} coefficients; the file has {}", path.string(), l.order,
+            throw Error(fmt::format("{}: order {} needs {} coefficients; the file has {}", name, l.order,
                                     sh_count(l.order), c.is_array() ? c.size() : 0),
                         "light");
         auto vec = [&](const nlohmann::json& a) {
-            const glm::vec3 v(a.at(0).get<float>(), a.at(1).get<float>(), a.at(2).get<float>());
-            if (a.size() != 3 || !std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
-                throw Error(fmt::format("{}: {} is not a finite 3-vector", path.string(), a.dump()), "light");
+            if (!a.is_array() || a.size() != 3 || !a[0].is_number() || !a[1].is_number() || !a[2].is_number())
+                throw Error(fmt::format("{}: {} is not a finite 3-vector", name, a.dump()), "light");
+            const glm::vec3 v(a[0].get<float>(), a[1].get<float>(), a[2].get<float>());
+            if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+                throw Error(fmt::format("{}: {} is not a finite 3-vector", name, a.dump()), "light");
             return v;
         };
         for (const auto& v : c)
@@ -115,11 +212,26 @@ ShLight load_light(const std::filesystem::path& path) {
         l.sun_direction = vec(j.at("sun_direction"));
         l.sun_irradiance = vec(j.at("sun_irradiance"));
     } catch (const nlohmann::json::exception& e) {
-        throw Error(fmt::format("{} is not a valid light file: {}", path.string(), e.what()), "light");
+        throw Error(fmt::format("{} is not a valid light file: {}", name, e.what()), "light");
     } catch (const Error& e) {
         throw Error(e.message(), "light");
     }
     return l;
+}
+
+ShLight load_light(const std::filesystem::path& path) {
+    std::string text;
+    try {
+        text = read_file(path, std::uint64_t(64) << 20);
+    } catch (const Error& e) {
+        throw Error(e.message(), "light");
+    }
+    return light_from_json(text, path.string());
+}
+
+PrtModel prt_from_sidecar_json(std::string_view sidecar, Mesh mesh, const std::string& sidecar_name,
+                               const std::string& mesh_name) {
+    return attach_transfer(parse_sidecar(sidecar, sidecar_name), std::move(mesh), sidecar_name, mesh_name);
 }
 
 PrtModel load_prt(const std::filesystem::path& mesh_path) {
@@ -129,72 +241,8 @@ PrtModel load_prt(const std::filesystem::path& mesh_path) {
         throw Error(fmt::format("no transfer sidecar {} beside {}; bake it with `skybake prt bake`", side.string(),
                                 mesh_path.string()),
                     "sidecar");
-    nlohmann::json j;
-    try {
-        j = nlohmann::json::parse(read_file(side, std::uint64_t(1) << 20));
-    } catch (const nlohmann::json::exception& e) {
-        throw Error(fmt::format("{} is not valid JSON: {}", side.string(), e.what()), "sidecar");
-    }
-    PrtModel m;
-    Transfer& t = m.transfer;
-    std::size_t vertices = 0;
-    try {
-        if (!j.is_object() || j.value("format", "") != kFormat)
-            throw Error(fmt::format("{} is not a skybake-prt sidecar", side.string()), "sidecar");
-        if (j.at("version").get<int>() != kVersion)
-            throw Error(fmt::format("{}: version {} is not {}", side.string(), j.at("version").dump(), kVersion),
-                        "sidecar");
-        t.order = j.at("order").get<int>();
-        t.coefficients = j.at("coefficients").get<int>();
-        t.channels = j.at("channels").get<int>();
-        t.kind = parse_transfer_kind(j.at("kind").get<std::string>());
-        t.model = parse_transfer_model(j.at("model").get<std::string>());
-        t.bounces = j.at("bounces").get<int>();
-        t.rule = j.at("rule").get<std::string>();
-        vertices = j.at("vertices").get<std::size_t>();
-    } catch (const nlohmann::json::exception& e) {
-        throw Error(fmt::format("{}: missing or wrong field ({})", side.string(), e.what()), "sidecar");
-    } catch (const Error& e) {
-        throw Error(fmt::format("{}: {}", side.string(), e.message()), "sidecar");
-    }
-    if (t.order < 0 || t.order > kPrtMaxOrder || t.coefficients != sh_count(t.order) ||
-        (t.channels != 1 && t.channels != 3))
-        throw Error(fmt::format("{}: order {}, {} coefficients and {} channels do not fit together", side.string(),
-                                t.order, t.coefficients, t.channels),
-                    "sidecar");
-    m.mesh = load_mesh(mesh_path);
-    const std::size_t n = m.mesh.vertex_count();
-    if (n != vertices)
-        throw Error(
-            fmt::format("{} describes {} vertices but {} has {}", side.string(), vertices, mesh_path.string(), n),
-            "sidecar");
-    const int per_vertex = t.channels * t.coefficients;
-    t.coeffs.assign(n * std::size_t(per_vertex), 0.0f);
-    for (int a = 0; a < attribute_count(t); ++a) {
-        const std::string name = fmt::format("prt_{}", a);
-        const VertexAttribute* attr = m.mesh.find_attribute(name);
-        if (!attr || attr->components != 4 || attr->values.size() != 4 * n)
-            throw Error(fmt::format("{} has no 4-component attribute {} that {} lists", mesh_path.string(), name,
-                                    side.string()),
-                        "sidecar");
-        for (std::size_t v = 0; v < n; ++v)
-            for (int k = 0; k < 4; ++k)
-                if (4 * a + k < per_vertex)
-                    t.coeffs[v * std::size_t(per_vertex) + std::size_t(4 * a + k)] =
-                        attr->values[4 * v + std::size_t(k)];
-    }
-    const VertexAttribute* alb = m.mesh.find_attribute("albedo");
-    if (!alb || alb->components != 3)
-        throw Error(fmt::format("{} has no 3-component albedo attribute", mesh_path.string()), "sidecar");
-    m.albedo.resize(n);
-    for (std::size_t v = 0; v < n; ++v)
-        m.albedo[v] = {alb->values[3 * v], alb->values[3 * v + 1], alb->values[3 * v + 2]};
-    if (const VertexAttribute* a = m.mesh.find_attribute("shading"); a && a->components == 1)
-        t.shading = a->values;
-    for (float x : t.coeffs)
-        if (!std::isfinite(x))
-            throw Error(fmt::format("{} has non-finite transfer coefficients", mesh_path.string()), "sidecar");
-    return m;
+    SidecarHeader h = parse_sidecar(read_file(side, std::uint64_t(1) << 20), side.string());
+    return attach_transfer(std::move(h), load_mesh(mesh_path), side.string(), mesh_path.string());
 }
 
 } // namespace skybake

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Fuzzes every parser with libFuzzer (clang, ASan + UBSan), then merges what
+# Fuzzes every parser with libFuzzer (clang, ASan + UBSan; undefined behaviour
+# stops the run like a crash), then merges what
 # found new coverage into the corpus kept in the repository.
 #   tools/fuzz/run.sh [TARGET...]          (default: every target)
 #   FUZZ_SECONDS=120 make fuzz             (seconds per target; default 120)
@@ -41,6 +42,7 @@ run_one() {
   [ "$t" = mesh_loader ] && seed_mesh_loader "$work"
   [ -f "$here/$t.dict" ] && dict=(-dict="$here/$t.dict")
   ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 LSAN_OPTIONS=suppressions=$here/lsan.supp \
+    UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
     "$build/fuzz_$t" "${dict[@]}" -max_total_time="$secs" -max_len=65536 -rss_limit_mb=4096 -timeout=20 \
     -print_final_stats=1 -artifact_prefix="$crashes/" "$work" >"$log" 2>&1 || true
   # Keep what adds coverage (and every crash) in the repository's corpus.
