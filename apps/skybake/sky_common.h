@@ -15,6 +15,8 @@ struct AtmosphereFlags {
     std::string file;
     double paper_r = 10000.0, paper_m = 10000.0;
     std::string table_rule; // empty: the atmosphere's own
+    std::string scattering, multiple_method; // empty: the atmosphere's own
+    int scattering_orders = 0;               // 0: the atmosphere's own
 
     void add(CLI::App& sub, bool allow_file = true) {
         sub.add_option("--preset", preset, "Atmosphere preset: earth (default), paper, paper-dense");
@@ -28,6 +30,13 @@ struct AtmosphereFlags {
             ->capture_default_str();
         sub.add_option("--table-rule", table_rule,
                        "Shell density rule of the tables: as-published (or seed) or refined (default: the atmosphere's own)");
+        sub.add_option("--scattering", scattering,
+                       "single (seed 000) or multiple (every order, ground bounces included); default: the atmosphere's own, single for the presets");
+        sub.add_option("--multiple-method", multiple_method,
+                       "With --scattering multiple: orders (Bruneton 2017's precomputed orders, default) or hillaire (Hillaire 2020's table, faster)");
+        sub.add_option("--scattering-orders", scattering_orders,
+                       "With --multiple-method orders: the highest scattering order counted, 2 to 32 (default 4)")
+            ->check(integer_in(2, 32));
     }
 
     Atmosphere load(const CLI::App& sub) const {
@@ -44,6 +53,18 @@ struct AtmosphereFlags {
                                     : load_atmosphere(file);
         if (!table_rule.empty())
             a.table_rule = parse_flag("--table-rule", [&] { return parse_table_rule(table_rule); });
+        if (!scattering.empty())
+            a.scattering = parse_flag("--scattering", [&] { return parse_scattering(scattering); });
+        if (!multiple_method.empty())
+            a.multiple_method =
+                parse_flag("--multiple-method", [&] { return parse_multiple_scattering_method(multiple_method); });
+        if (scattering_orders != 0)
+            a.scattering_orders = scattering_orders;
+        if (a.scattering == Scattering::Single)
+            for (const char* f : {"--multiple-method", "--scattering-orders"})
+                refuse_if_given(sub, f, "to single scattering (add --scattering multiple)");
+        if (a.multiple_method != MultipleScatteringMethod::Orders)
+            refuse_if_given(sub, "--scattering-orders", "to --multiple-method hillaire (it sums every order)");
         return a;
     }
 };
@@ -62,7 +83,7 @@ struct ModelFlag {
         if (!atm.preset.empty() || !atm.file.empty())
             throw UsageError("a weights file carries its own atmosphere; drop --preset/--atmosphere", "--model");
         for (const char* flag : {"--method", "--table-rule", "--steps", "--uniform-steps", "--shells", "--cosines",
-                                 "--paper-r", "--paper-m"})
+                                 "--paper-r", "--paper-m", "--scattering", "--multiple-method", "--scattering-orders"})
             refuse_if_given(sub, flag, "to a neural sky (--model)");
         return load_neural_sky(path);
     }

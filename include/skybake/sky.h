@@ -1,9 +1,11 @@
 // skybake/sky.h: single-scattering sky model (Nishita et al. 1993) with the
 // optical-length tables and the marching sum of Pietras & Rudnicki (seed 000),
-// and an exact double-precision reference.
+// an exact double-precision reference, and multiple scattering (Bruneton 2017's
+// precomputed orders or Hillaire 2020's look-up table) added on request.
 //
 // [SECTION] Units and frames
 // [SECTION] Atmosphere description
+// [SECTION] Multiple scattering
 // [SECTION] Presets and JSON files
 // [SECTION] Phase functions and density profiles
 // [SECTION] Input space of the sky function
@@ -90,6 +92,26 @@ enum class TableRule : int {
 const char* table_rule_name(TableRule rule);
 TableRule parse_table_rule(const std::string& text, const std::string& where = "table_rule");
 
+// Which light the sky function counts (see [SECTION] Multiple scattering).
+enum class Scattering : int {
+    Single = 0,   // "single": light scattered once, as in seed 000 (the default of every preset)
+    Multiple = 1, // "multiple": every order, with ground bounces at ground_albedo
+};
+enum class MultipleScatteringMethod : int {
+    // "orders": Bruneton 2017's precomputed scattering orders 2..scattering_orders
+    // in double precision on a 4D grid over (r, μ, μs, ν), ground bounces included.
+    Orders = 0,
+    // "hillaire": Hillaire 2020's isotropic ψms(h, μs) table (orders to infinity,
+    // as a geometric series), added along the view ray: the fast path.
+    Hillaire = 1,
+};
+const char* scattering_name(Scattering scattering);
+const char* multiple_scattering_method_name(MultipleScatteringMethod method);
+// Parse "single"/"multiple" and "orders"/"hillaire"; throw skybake::Error naming `where` otherwise.
+Scattering parse_scattering(const std::string& text, const std::string& where = "scattering");
+MultipleScatteringMethod parse_multiple_scattering_method(const std::string& text,
+                                                         const std::string& where = "multiple_method");
+
 struct Atmosphere {
     std::string name;
     double planet_radius_km = 6360.0; // R0, the ground
@@ -105,6 +127,11 @@ struct Atmosphere {
     double sun_angular_radius_rad = 0.004675;
     glm::dvec3 ground_albedo{0.1};   // Lambertian ground reflectance C, per channel, in [0, 1]
     TableRule table_rule = TableRule::AsPublished;
+    // Multiple scattering (JSON "scattering", "multiple_method", "scattering_orders";
+    // written only when not single, so single-scattering files are unchanged).
+    Scattering scattering = Scattering::Single;
+    MultipleScatteringMethod multiple_method = MultipleScatteringMethod::Orders;
+    int scattering_orders = 4; // Orders only: the highest order counted, 2 to 32 (Bruneton's default is 4)
 
     // Throws skybake::Error naming the first bad field.
     void validate() const;
@@ -225,6 +252,37 @@ enum class SkyMethod : int {
     Exact = 1,  // adaptive quadrature along the true geometry (double)
 };
 
+// [SECTION] Multiple scattering ---------------------------------------------------
+//
+// With Atmosphere::scattering == Multiple, every radiance of SkyModel (both
+// methods, the renderer, the CUDA path) adds the light scattered two or more
+// times to the single-scattering sum: I = I1 + Ims. Ims comes from tables
+// built once in the SkyModel constructor, in double precision:
+//   orders:   Bruneton 2017. Transmittance T(r, μ); single scattering per
+//             component without its phase; then for n = 2..N the scattering
+//             density J_n (the order n − 1 radiance and the ground's order n − 1
+//             irradiance, reflected at the albedo, integrated over the sphere with
+//             each component's phase), the order-n radiance ∫ T J_n along every
+//             ray, and the ground irradiance of order n. Ims = Σ_{n≥2} order n,
+//             quadrilinear in the 4D grid.
+//   hillaire: Hillaire 2020. For each altitude and sun cosine, the
+//             second-order light L2 and the transfer f_ms of an isotropic
+//             medium, ψms = L2 / (1 − f_ms); along the view ray Ims = ∫ T σs ψms.
+// The sky irradiance of a horizontal surface (scattered light only) is
+// tabulated from the model's own total radiance; the surface colour and the
+// rendered ground add it to the direct sun. A brute-force path tracer
+// (skybake/sky_path_tracer.h) is the reference for both methods.
+struct MultipleScatteringResolution {
+    int r = 16;        // radius nodes of the orders grid, ≥ 2
+    int mu = 32;       // view-cosine nodes per half (above / below the horizon), ≥ 2
+    int mu_s = 16;     // sun-cosine nodes, ≥ 2
+    int nu = 8;        // view–sun cosine nodes, ≥ 2
+    int sphere = 16;   // polar samples of the sphere integrals (azimuth: twice as many), ≥ 4
+    int psi_r = 32, psi_mu_s = 32;           // Hillaire's ψms table, ≥ 2 each
+    int irradiance_r = 8, irradiance_mu_s = 64; // sky irradiance table, ≥ 2 each
+    double mu_s_min = -0.2; // lowest sun cosine of the orders grid (Bruneton: cos 102°), in (−1, 0]
+};
+
 struct SkyModelOptions {
     TableResolution tables{};
     // Steps of the seed's sum along the view ray (midpoint rule).
@@ -235,6 +293,8 @@ struct SkyModelOptions {
     bool uniform_steps = false;
     // Relative tolerance of the exact quadrature.
     double exact_tolerance = 1e-7;
+    // Tables of multiple scattering (used when the atmosphere asks for it).
+    MultipleScatteringResolution multiple{};
 };
 
 // Single-scattered radiance I per unit sun irradiance, in 1/sr, looking from
@@ -264,7 +324,19 @@ public:
     glm::dvec3 radiance_at_radius(double radius_km, double cos_view_zenith, double cos_view_sun,
                                   double cos_sun_zenith, SkyMethod method) const;
     // Seed's sum with an explicit step count and spacing (for convergence studies).
+    // Single scattering only, whatever the atmosphere's scattering.
     glm::dvec3 radiance_tables(const SkySample& sample, int steps, bool uniform_steps = false) const;
+    // The multiple-scattering part Ims of radiance() (zero for single scattering),
+    // from an observer at radius_km (may be above the top).
+    glm::dvec3 multiple_radiance_at_radius(double radius_km, double cos_view_zenith, double cos_view_sun,
+                                           double cos_sun_zenith) const;
+    // Irradiance of the scattered sky light on a horizontal surface at
+    // altitude_km (≥ 0) with the sun at cos_sun_zenith, per unit sun irradiance
+    // (the direct sun excluded). Zero for single scattering.
+    glm::dvec3 sky_irradiance(double altitude_km, double cos_sun_zenith) const;
+    // Wall-clock seconds the constructor spent on the multiple-scattering tables, and their bytes.
+    double multiple_precompute_seconds() const;
+    std::size_t multiple_table_bytes() const;
 
 private:
     friend const sky::AtmosphereHD& sky::atmosphere_hd(const SkyModel& model);
@@ -290,7 +362,8 @@ struct SurfaceLight {
     // Light scattered into the view between observer and surface point, 1/sr:
     glm::dvec3 inscatter_seed{0.0};  // the seed's difference I(observer) − I(probe at the surface), tables
     glm::dvec3 inscatter_exact{0.0}; // exact quadrature over the segment
-    // Sunlight reflected by the Lambertian surface and attenuated to the observer, 1/sr:
+    // Sunlight reflected by the Lambertian surface and attenuated to the observer, 1/sr
+    // (with multiple scattering, plus the sky's light: albedo/π times SkyModel::sky_irradiance):
     glm::dvec3 reflected_tables{0.0};
     glm::dvec3 reflected_exact{0.0};
     glm::dvec3 transmittance_exact{1.0}; // observer <- surface point

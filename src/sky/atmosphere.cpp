@@ -49,6 +49,28 @@ constexpr NamedValue<TableRule> kTableRuleNames[] = {
 
 const char* table_rule_name(TableRule rule) { return name_of(kTableRuleNames, rule); }
 
+namespace {
+constexpr NamedValue<Scattering> kScatteringNames[] = {
+    {Scattering::Single, "single", "light scattered once (seed 000)"},
+    {Scattering::Multiple, "multiple", "every order, ground bounces included"},
+};
+constexpr NamedValue<MultipleScatteringMethod> kMultipleMethodNames[] = {
+    {MultipleScatteringMethod::Orders, "orders", "Bruneton 2017's precomputed scattering orders"},
+    {MultipleScatteringMethod::Hillaire, "hillaire", "Hillaire 2020's isotropic multiple-scattering table"},
+};
+} // namespace
+
+const char* scattering_name(Scattering scattering) { return name_of(kScatteringNames, scattering); }
+const char* multiple_scattering_method_name(MultipleScatteringMethod method) {
+    return name_of(kMultipleMethodNames, method);
+}
+Scattering parse_scattering(const std::string& text, const std::string& where) {
+    return parse_name(kScatteringNames, text, "scattering", where);
+}
+MultipleScatteringMethod parse_multiple_scattering_method(const std::string& text, const std::string& where) {
+    return parse_name(kMultipleMethodNames, text, "multiple-scattering method", where);
+}
+
 TableRule parse_table_rule(const std::string& text, const std::string& where) {
     return parse_name(kTableRuleNames, text, "table rule", where);
 }
@@ -161,6 +183,12 @@ void Atmosphere::validate() const {
     for (int i = 0; i < 3; ++i)
         if (!(ground_albedo[i] >= 0.0 && ground_albedo[i] <= 1.0))
             throw Error("ground_albedo must be in [0, 1]", where);
+    if (scattering != Scattering::Single && scattering != Scattering::Multiple)
+        throw Error("scattering must be single or multiple", where);
+    if (multiple_method != MultipleScatteringMethod::Orders && multiple_method != MultipleScatteringMethod::Hillaire)
+        throw Error("multiple_method must be orders or hillaire", where);
+    if (scattering_orders < 2 || scattering_orders > 32)
+        throw Error("scattering_orders must be 2 to 32", where);
 }
 
 double Atmosphere::altitude_from_density(double rho) const {
@@ -262,6 +290,11 @@ std::string atmosphere_to_json(const Atmosphere& a) {
                 {"irradiance", vec_json(a.sun_irradiance)},
                 {"angular_radius_rad", a.sun_angular_radius_rad}};
     j["ground_albedo"] = vec_json(a.ground_albedo);
+    if (a.scattering != Scattering::Single) {
+        j["scattering"] = scattering_name(a.scattering);
+        j["multiple_method"] = multiple_scattering_method_name(a.multiple_method);
+        j["scattering_orders"] = a.scattering_orders;
+    }
     return j.dump(2) + "\n";
 }
 
@@ -322,6 +355,11 @@ Atmosphere atmosphere_from_json(std::string_view text, const std::string& where)
         a.sun_angular_radius_rad = get<double>(sj, "angular_radius_rad", where, &a.sun_angular_radius_rad);
     }
     a.ground_albedo = get_vec(j, "ground_albedo", where, &a.ground_albedo);
+    const std::string single = scattering_name(Scattering::Single);
+    const std::string orders = multiple_scattering_method_name(MultipleScatteringMethod::Orders);
+    a.scattering = parse_scattering(get<std::string>(j, "scattering", where, &single), where);
+    a.multiple_method = parse_multiple_scattering_method(get<std::string>(j, "multiple_method", where, &orders), where);
+    a.scattering_orders = get<int>(j, "scattering_orders", where, &a.scattering_orders);
     try {
         a.validate();
     } catch (const Error& e) {

@@ -29,12 +29,20 @@ glm::dvec3 shade_ray_exact(const Atmosphere& atm, const sky::RenderHD& p, const 
     }
     glm::dvec3 t;
     c = sky::inscatter_exact(atm, eye + enter * d, d, exit - enter, sun, tol, &t);
+    const bool multiple = p.atm.ms.method != sky::kMultipleNone;
+    if (multiple) // the tables' multiple scattering on top of the exact single scattering
+        c += glm::dvec3(sky::multiple_residual(
+            p.atm, sky::ObserverHD{p.eye_r, p.eye_h, float(d.z), float(glm::dot(d, sun)), float(sun.z)}, p.steps, p.spacing));
     if (ground) {
         const glm::dvec3 g = eye + exit * d;
         const double cos_sun = glm::dot(glm::normalize(g), sun);
-        if (cos_sun > 0.0) {
-            glm::dvec3 r = glm::dvec3(p.albedo) * (cos_sun / 3.14159265358979323846) *
-                           sky::sun_transmittance_exact(atm, g, sun) * t;
+        if (cos_sun > 0.0 || multiple) {
+            glm::dvec3 r(0.0);
+            if (cos_sun > 0.0)
+                r = glm::dvec3(p.albedo) * (cos_sun / 3.14159265358979323846) * sky::sun_transmittance_exact(atm, g, sun) * t;
+            if (multiple)
+                r += glm::dvec3(p.albedo) / 3.14159265358979323846 *
+                     glm::dvec3(sky::sky_irradiance_lookup(p.atm.ms, p.atm.R0, p.atm.Rtop, 0.0f, float(cos_sun))) * t;
             if (p.published_ground) {
                 glm::dvec3 b(0.0);
                 for (const AtmosphereComponent& k : atm.components)

@@ -4,7 +4,8 @@
 //
 // Pietras & Rudnicki (seed 000) sections II and IV: the sky is the marching
 // sum; the ground adds the sunlight reflected by a Lambertian surface,
-// attenuated by the atmosphere on both paths.
+// attenuated by the atmosphere on both paths (and, with multiple scattering,
+// the reflected sky irradiance).
 #pragma once
 
 #include <glm/geometric.hpp>
@@ -69,7 +70,7 @@ SKYBAKE_HD_INLINE bool pixel_direction(const RenderHD& p, int x, int y, glm::vec
 SKYBAKE_HD_INLINE glm::vec3 shade_ray(const RenderHD& p, const glm::vec3& d) {
     const AtmosphereHD& a = p.atm;
     ObserverHD o{p.eye_r, p.eye_h, d.z, glm::dot(d, p.sun), p.sun.z};
-    glm::vec3 c = seed_sky_sum(a, o, p.steps, p.spacing);
+    glm::vec3 c = sky_sum(a, o, p.steps, p.spacing);
 
     // Ground: first intersection with the sphere R0.
     const float b = p.eye_r * d.z;
@@ -82,8 +83,12 @@ SKYBAKE_HD_INLINE glm::vec3 shade_ray(const RenderHD& p, const glm::vec3& d) {
         const glm::vec3 g(t * d.x, t * d.y, p.eye_r + t * d.z);
         const glm::vec3 n = g / glm::length(g);
         const float cos_sun = glm::dot(n, p.sun);
-        if (cos_sun > 0.0f) {
-            glm::vec3 reflected = p.albedo * (cos_sun / kPi) * sun_transmittance(a, a.R0, 0.0f, cos_sun);
+        if (cos_sun > 0.0f || a.ms.irradiance != nullptr) {
+            glm::vec3 reflected(0.0f);
+            if (cos_sun > 0.0f)
+                reflected = p.albedo * (cos_sun / kPi) * sun_transmittance(a, a.R0, 0.0f, cos_sun);
+            if (a.ms.irradiance != nullptr) // the sky's light, with multiple scattering
+                reflected += p.albedo * (1.0f / kPi) * sky_irradiance_lookup(a.ms, a.R0, a.Rtop, 0.0f, cos_sun);
             if (p.published_ground) {
                 glm::vec3 b(0.0f);
                 for (int k = 0; k < a.count; ++k)

@@ -20,7 +20,7 @@ __global__ void sky_sum_kernel(sky::AtmosphereHD a, const sky::ObserverHD* obs, 
                                int steps, int spacing) {
     const std::size_t i = std::size_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i < n)
-        out[i] = sky::seed_sky_sum(a, obs[i], steps, spacing);
+        out[i] = sky::sky_sum(a, obs[i], steps, spacing);
 }
 
 __global__ void sky_render_kernel(sky::RenderHD p, float* rgb) {
@@ -49,7 +49,22 @@ struct DeviceAtmosphere {
             tables[std::size_t(k)].upload(hd.comp[k].table.L, n);
             hd.comp[k].table.L = tables[std::size_t(k)].data();
         }
+        // Multiple scattering: the orders grid or Hillaire's table, and the sky irradiance.
+        sky::MultipleHD& m = hd.ms;
+        if (m.orders) {
+            orders.upload(m.orders, std::size_t(m.nr) * 2u * std::size_t(m.nmu) * std::size_t(m.nmus) * std::size_t(m.nnu) * 3u);
+            m.orders = orders.data();
+        }
+        if (m.psi) {
+            psi.upload(m.psi, std::size_t(m.psi_nr) * std::size_t(m.psi_nmus) * 3u);
+            m.psi = psi.data();
+        }
+        if (m.irradiance) {
+            irradiance.upload(m.irradiance, std::size_t(m.irr_nr) * std::size_t(m.irr_nmus) * 3u);
+            m.irradiance = irradiance.data();
+        }
     }
+    cuda::DeviceBuffer<float> orders, psi, irradiance;
 };
 
 } // namespace

@@ -15,6 +15,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/hd.h"
+#include "sky/multiple_hd.h"
 
 namespace skybake::sky {
 
@@ -52,6 +53,7 @@ struct AtmosphereHD {
     float Rtop = 6420.0f; // top of the atmosphere, km
     int count = 0;
     ComponentHD comp[kMaxComponents];
+    MultipleHD ms; // multiple scattering (method kMultipleNone: single scattering only)
 };
 
 // ---- phase functions (1/sr), mu = cos(angle between V and L) ------------------
@@ -264,17 +266,54 @@ SKYBAKE_HD_INLINE void sum_point(const AtmosphereHD& a, const ObserverHD& o, con
     result += weight * (dv * glm::vec3(expf(-tau.x), expf(-tau.y), expf(-tau.z)));
 }
 
-// n midpoints on [v0, v0 ± D] graded from v0 with scale s (dir = ±1).
-SKYBAKE_HD_INLINE void sum_graded(const AtmosphereHD& a, const ObserverHD& o, const SumState& st, float v0, float D,
-                                  float dir, float s, int n, glm::vec3& result) {
+// One midpoint of the single-scattering sum (sum_point), as a functor.
+struct SinglePoint {
+    const AtmosphereHD& a;
+    const ObserverHD& o;
+    const SumState& st;
+    glm::vec3& result;
+    SKYBAKE_HD_INLINE void operator()(float v, float dv) const { sum_point(a, o, st, v, dv, result); }
+};
+
+// n midpoints on [v0, v0 ± D] graded from v0 with scale s (dir = ±1); point(v, Δv) for each.
+template <class Point>
+SKYBAKE_HD_INLINE void march_graded(float v0, float D, float dir, float s, int n, const Point& point) {
     if (n <= 0 || D <= 0.0f)
         return;
     const float w = logf(1.0f + D / s);
     for (int j = 0; j < n; ++j) {
         const float t = (float(j) + 0.5f) / float(n);
         const float e = expf(w * t);
-        sum_point(a, o, st, v0 + dir * s * (e - 1.0f), s * w * e / float(n), result);
+        point(v0 + dir * s * (e - 1.0f), s * w * e / float(n));
     }
+}
+
+// The midpoints of a view ray of `length` km from an observer inside the
+// atmosphere (base = r0² − R0²): uniform, or graded away from the lowest point.
+template <class Point>
+SKYBAKE_HD_INLINE void march_view_ray(const AtmosphereHD& a, const ObserverHD& o, float base, float length, int steps,
+                                      int spacing, const Point& point) {
+    if (spacing == kStepsUniform) {
+        const float dv = length / float(steps);
+        for (int j = 0; j < steps; ++j)
+            point((float(j) + 0.5f) * dv, dv);
+        return;
+    }
+    // The lowest point of the segment and the cosine to the vertical there.
+    float v_low = -o.r * o.cv;
+    v_low = v_low < 0.0f ? 0.0f : (v_low > length ? length : v_low);
+    float d2 = base + v_low * (v_low + 2.0f * o.r * o.cv);
+    const float r_low = sqrtf(a.R0 * a.R0 + (d2 > 0.0f ? d2 : 0.0f));
+    const float mu_low = fabsf(o.r * o.cv + v_low) / r_low;
+    const float H = 1.0f / a.comp[0].inv_scale_height;
+    const float s = H / (mu_low + sqrtf(2.0f * H / r_low));
+    const float before = v_low, after = length - v_low;
+    const float wb = logf(1.0f + before / s), wa = logf(1.0f + after / s);
+    int nb = int(float(steps) * wb / (wb + wa) + 0.5f);
+    nb = before > 0.0f && nb < 1 ? 1 : nb;
+    nb = after > 0.0f && nb > steps - 1 ? steps - 1 : nb;
+    march_graded(v_low, before, -1.0f, s, nb, point);
+    march_graded(v_low, after, 1.0f, s, steps - nb, point);
 }
 
 SKYBAKE_HD_INLINE glm::vec3 seed_sky_sum(const AtmosphereHD& a, ObserverHD o, int steps, int spacing = kStepsGraded) {
@@ -295,28 +334,7 @@ SKYBAKE_HD_INLINE glm::vec3 seed_sky_sum(const AtmosphereHD& a, ObserverHD o, in
     }
     // r_v² − R0² = (r0² − R0²) + v² + 2 r0 v cos α0, kept as a difference for precision.
     st.base = o.h * (2.0f * a.R0 + o.h);
-
-    if (spacing == kStepsUniform) {
-        const float dv = length / float(steps);
-        for (int j = 0; j < steps; ++j)
-            sum_point(a, o, st, (float(j) + 0.5f) * dv, dv, result);
-        return result;
-    }
-    // The lowest point of the segment and the cosine to the vertical there.
-    float v_low = -o.r * o.cv;
-    v_low = v_low < 0.0f ? 0.0f : (v_low > length ? length : v_low);
-    float d2 = st.base + v_low * (v_low + 2.0f * o.r * o.cv);
-    const float r_low = sqrtf(a.R0 * a.R0 + (d2 > 0.0f ? d2 : 0.0f));
-    const float mu_low = fabsf(o.r * o.cv + v_low) / r_low;
-    const float H = 1.0f / a.comp[0].inv_scale_height;
-    const float s = H / (mu_low + sqrtf(2.0f * H / r_low));
-    const float before = v_low, after = length - v_low;
-    const float wb = logf(1.0f + before / s), wa = logf(1.0f + after / s);
-    int nb = int(float(steps) * wb / (wb + wa) + 0.5f);
-    nb = before > 0.0f && nb < 1 ? 1 : nb;
-    nb = after > 0.0f && nb > steps - 1 ? steps - 1 : nb;
-    sum_graded(a, o, st, v_low, before, -1.0f, s, nb, result);
-    sum_graded(a, o, st, v_low, after, 1.0f, s, steps - nb, result);
+    march_view_ray(a, o, st.base, length, steps, spacing, SinglePoint{a, o, st, result});
     return result;
 }
 
@@ -348,6 +366,68 @@ SKYBAKE_HD_INLINE glm::vec3 sun_transmittance(const AtmosphereHD& a, float r, fl
         tau += c.ext * optical_length_lookup(a, c, r, u, cos_sun_zenith);
     }
     return glm::vec3(expf(-tau.x), expf(-tau.y), expf(-tau.z));
+}
+
+// ---- multiple scattering ---------------------------------------------------------------
+//
+// Hillaire 2020, eq. (10): along the view ray, every point adds
+// σs(x) ψms(h, μs) times the transmittance back to the observer (the seed's
+// table difference L[ρ0, cos α0] − L[ρv, cos αv]).
+struct HillairePoint {
+    const AtmosphereHD& a;
+    const ObserverHD& o;
+    const float* l_obs;
+    float base;
+    glm::vec3& result;
+    SKYBAKE_HD_INLINE void operator()(float v, float dv) const {
+        float d2 = base + v * (v + 2.0f * o.r * o.cv);
+        d2 = d2 > 0.0f ? d2 : 0.0f;
+        const float rv = sqrtf(a.R0 * a.R0 + d2);
+        const float hv = d2 / (rv + a.R0);
+        const StepCosines c_v = step_cosines(o, v, 1.0f / rv);
+        glm::vec3 tau(0.0f), sigma_s(0.0f);
+        for (int k = 0; k < a.count; ++k) {
+            const ComponentHD& c = a.comp[k];
+            const float rho = component_density(c, hv);
+            const float u = table_coordinate(a, c, hv, rho);
+            tau += c.ext * (l_obs[k] - optical_length_lookup(a, c, rv, u, c_v.view_zenith));
+            sigma_s += c.sca * rho;
+        }
+        const glm::vec3 psi = psi_lookup(a.ms, a.R0, a.Rtop, hv, c_v.sun_zenith);
+        result += sigma_s * psi * (dv * glm::vec3(expf(-tau.x), expf(-tau.y), expf(-tau.z)));
+    }
+};
+
+// The light scattered more than once that reaches the observer along V
+// (1/sr per unit sun irradiance): the orders grid at the point where the view
+// ray starts inside the atmosphere, or Hillaire's march; zero for single scattering.
+SKYBAKE_HD_INLINE glm::vec3 multiple_residual(const AtmosphereHD& a, ObserverHD o, int steps, int spacing = kStepsGraded) {
+    glm::vec3 result(0.0f);
+    if (a.ms.method == kMultipleNone || !enter_atmosphere(a, o))
+        return result;
+    if (a.ms.method == kMultipleOrders)
+        return orders_lookup(a.ms, a.R0, a.Rtop, o.r, o.cv, o.cs, o.cvs);
+    const float ground = distance_to_ground(o.r, o.cv, a.R0);
+    const float length = ground >= 0.0f ? ground : distance_to_sphere_exit(o.r, o.cv, a.Rtop);
+    if (length <= 0.0f || steps <= 0)
+        return result;
+    float l_obs[kMaxComponents];
+    for (int k = 0; k < a.count; ++k) {
+        const ComponentHD& c = a.comp[k];
+        l_obs[k] = optical_length_lookup(a, c, o.r, table_coordinate(a, c, o.h, component_density(c, o.h)), o.cv);
+    }
+    const float base = o.h * (2.0f * a.R0 + o.h);
+    march_view_ray(a, o, base, length, steps, spacing, HillairePoint{a, o, l_obs, base, result});
+    return result;
+}
+
+// The sky colour of the model: the seed's single-scattering sum plus, when the
+// atmosphere has them, the orders of multiple scattering.
+SKYBAKE_HD_INLINE glm::vec3 sky_sum(const AtmosphereHD& a, const ObserverHD& o, int steps, int spacing = kStepsGraded) {
+    glm::vec3 c = seed_sky_sum(a, o, steps, spacing);
+    if (a.ms.method != kMultipleNone)
+        c += multiple_residual(a, o, steps, spacing);
+    return c;
 }
 
 } // namespace skybake::sky

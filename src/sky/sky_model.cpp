@@ -3,11 +3,14 @@
 // (exact.cpp); batch evaluation over all cores.
 #include <algorithm>
 #include <cassert>
+#include <chrono>
 #include <cmath>
 
 #include "core/parallel.h"
 #include "skybake/error.h"
 #include "sky/internal.h"
+#include "sky/multiple_scattering_lut.h"
+#include "sky/scattering_orders.h"
 
 namespace skybake {
 
@@ -16,7 +19,61 @@ struct SkyModel::Impl {
     SkyModelOptions options;
     OpticalLengthTables tables;
     sky::AtmosphereHD hd;
+    // Multiple scattering (empty for single scattering).
+    std::vector<float> orders, psi, irradiance;
+    double multiple_seconds = 0.0;
+
+    void build_multiple();
 };
+
+namespace {
+
+void check_multiple_resolution(const MultipleScatteringResolution& m) {
+    const auto in = [](int v, int lo, int hi) { return v >= lo && v <= hi; };
+    if (!in(m.r, 2, 512) || !in(m.mu, 2, 1024) || !in(m.mu_s, 2, 512) || !in(m.nu, 2, 512))
+        throw Error("the orders grid needs 2 to 512 nodes per axis (mu: 2 to 1024 per half)", "multiple");
+    if (double(m.r) * 2.0 * m.mu * m.mu_s * m.nu > double(1 << 24))
+        throw Error("the orders grid may have at most 16777216 nodes", "multiple");
+    if (!in(m.sphere, 4, 256))
+        throw Error("the sphere integrals need 4 to 256 polar samples", "multiple.sphere");
+    if (!in(m.psi_r, 2, 4096) || !in(m.psi_mu_s, 2, 4096) || !in(m.irradiance_r, 2, 4096) ||
+        !in(m.irradiance_mu_s, 2, 4096))
+        throw Error("the psi and irradiance tables need 2 to 4096 nodes per axis", "multiple");
+    if (!(m.mu_s_min > -1.0 && m.mu_s_min <= 0.0))
+        throw Error("mu_s_min must be in (-1, 0]", "multiple.mu_s_min");
+}
+
+} // namespace
+
+void SkyModel::Impl::build_multiple() {
+    if (atmosphere.scattering != Scattering::Multiple)
+        return;
+    const auto start = std::chrono::steady_clock::now();
+    const MultipleScatteringResolution& res = options.multiple;
+    sky::MultipleHD& m = hd.ms;
+    m.mu_s_min = float(res.mu_s_min);
+    if (atmosphere.multiple_method == MultipleScatteringMethod::Orders) {
+        orders = sky::ScatteringOrders::compute(atmosphere, res, atmosphere.scattering_orders).residual();
+        m.method = sky::kMultipleOrders;
+        m.orders = orders.data();
+        m.nr = res.r;
+        m.nmu = res.mu;
+        m.nmus = res.mu_s;
+        m.nnu = res.nu;
+    } else {
+        psi = sky::hillaire_psi_table(atmosphere, res);
+        m.method = sky::kMultipleHillaire;
+        m.psi = psi.data();
+        m.psi_nr = res.psi_r;
+        m.psi_nmus = res.psi_mu_s;
+    }
+    irradiance = sky::sky_irradiance_table(hd, res, options.steps,
+                                           options.uniform_steps ? sky::kStepsUniform : sky::kStepsGraded);
+    m.irradiance = irradiance.data();
+    m.irr_nr = res.irradiance_r;
+    m.irr_nmus = res.irradiance_mu_s;
+    multiple_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 
 SkyModel::SkyModel(Atmosphere atmosphere, const SkyModelOptions& options) : impl_(std::make_unique<Impl>()) {
     atmosphere.validate();
@@ -29,6 +86,9 @@ SkyModel::SkyModel(Atmosphere atmosphere, const SkyModelOptions& options) : impl
     impl_->options = options;
     impl_->tables = OpticalLengthTables::build(impl_->atmosphere, options.tables);
     impl_->hd = sky::make_atmosphere_hd(impl_->atmosphere, impl_->tables);
+    if (impl_->atmosphere.scattering == Scattering::Multiple)
+        check_multiple_resolution(options.multiple);
+    impl_->build_multiple();
 }
 
 SkyModel::~SkyModel() = default;
@@ -74,18 +134,37 @@ glm::dvec3 exact_radiance(const Atmosphere& atm, double r0, double cv, double cv
 
 glm::dvec3 SkyModel::radiance(const SkySample& s, SkyMethod method) const {
     assert(is_valid_sky_sample(s, 1e-4));
+    const sky::ObserverHD o = sky::make_observer(impl_->atmosphere, s);
     if (method == SkyMethod::Tables)
-        return glm::dvec3(sky::seed_sky_sum(impl_->hd, sky::make_observer(impl_->atmosphere, s), impl_->options.steps, spacing()));
+        return glm::dvec3(sky::sky_sum(impl_->hd, o, impl_->options.steps, spacing()));
     const double r0 = impl_->atmosphere.planet_radius_km + impl_->atmosphere.altitude_from_density(s.density);
     return exact_radiance(impl_->atmosphere, r0, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith,
-                          impl_->options.exact_tolerance);
+                          impl_->options.exact_tolerance) +
+           glm::dvec3(sky::multiple_residual(impl_->hd, o, impl_->options.steps, spacing()));
 }
 
 glm::dvec3 SkyModel::radiance_at_radius(double r0, double cv, double cvs, double cs, SkyMethod method) const {
+    const sky::ObserverHD o = sky::make_observer(impl_->atmosphere, r0, cv, cvs, cs);
     if (method == SkyMethod::Tables)
-        return glm::dvec3(
-            sky::seed_sky_sum(impl_->hd, sky::make_observer(impl_->atmosphere, r0, cv, cvs, cs), impl_->options.steps, spacing()));
-    return exact_radiance(impl_->atmosphere, r0, cv, cvs, cs, impl_->options.exact_tolerance);
+        return glm::dvec3(sky::sky_sum(impl_->hd, o, impl_->options.steps, spacing()));
+    return exact_radiance(impl_->atmosphere, r0, cv, cvs, cs, impl_->options.exact_tolerance) +
+           glm::dvec3(sky::multiple_residual(impl_->hd, o, impl_->options.steps, spacing()));
+}
+
+glm::dvec3 SkyModel::multiple_radiance_at_radius(double r0, double cv, double cvs, double cs) const {
+    return glm::dvec3(sky::multiple_residual(impl_->hd, sky::make_observer(impl_->atmosphere, r0, cv, cvs, cs),
+                                             impl_->options.steps, spacing()));
+}
+
+glm::dvec3 SkyModel::sky_irradiance(double altitude_km, double cos_sun_zenith) const {
+    const sky::AtmosphereHD& a = impl_->hd;
+    return glm::dvec3(sky::sky_irradiance_lookup(a.ms, a.R0, a.Rtop, float(altitude_km), float(cos_sun_zenith)));
+}
+
+double SkyModel::multiple_precompute_seconds() const { return impl_->multiple_seconds; }
+
+std::size_t SkyModel::multiple_table_bytes() const {
+    return (impl_->orders.size() + impl_->psi.size() + impl_->irradiance.size()) * sizeof(float);
 }
 
 glm::dvec3 SkyModel::radiance_tables(const SkySample& s, int steps, bool uniform_steps) const {
@@ -103,7 +182,7 @@ void evaluate_sky(const SkyModel& model, std::span<const SkySample> samples, std
         const int spacing = model.options().uniform_steps ? sky::kStepsUniform : sky::kStepsGraded;
         parallel_for(samples.size(), 1024, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i)
-                out[i] = sky::seed_sky_sum(hd, sky::make_observer(atm, samples[i]), steps, spacing);
+                out[i] = sky::sky_sum(hd, sky::make_observer(atm, samples[i]), steps, spacing);
         });
         return;
     }

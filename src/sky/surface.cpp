@@ -47,6 +47,9 @@ SurfaceLight surface_light(const SkyModel& model, const glm::dvec3& observer, co
     const double cos_sun = glm::dot(n, sun);
     const glm::dvec3 lambert = albedo * (std::max(0.0, cos_sun) / 3.14159265358979323846);
     out.reflected_exact = lambert * sky::sun_transmittance_exact(atm, surface, sun) * t_exact;
+    // With multiple scattering the surface is also lit by the sky.
+    const glm::dvec3 sky_light = albedo / 3.14159265358979323846 * model.sky_irradiance(hs, cos_sun);
+    out.reflected_exact += sky_light * t_exact;
 
     // The seed's difference of two sky evaluations.
     const double ro = glm::length(observer);
@@ -58,13 +61,15 @@ SurfaceLight surface_light(const SkyModel& model, const glm::dvec3& observer, co
     out.inscatter_seed = i_obs - i_probe;
 
     // Reflected light with the tables.
-    if (cos_sun > 0.0) {
+    if (cos_sun > 0.0 || hd.ms.irradiance != nullptr) {
         sky::ObserverHD e = sky::make_observer(atm, ro, glm::dot(observer, V) / ro, mu_vs, glm::dot(observer, sun) / ro);
         glm::vec3 t(1.0f);
         if (sky::enter_atmosphere(hd, e))
             t = sky::segment_transmittance(hd, e.r, e.h, e.cv, float(rs), float(hs), float(glm::dot(n, V)));
-        out.reflected_tables =
-            lambert * glm::dvec3(sky::sun_transmittance(hd, float(rs), float(hs), float(cos_sun))) * glm::dvec3(t);
+        if (cos_sun > 0.0)
+            out.reflected_tables =
+                lambert * glm::dvec3(sky::sun_transmittance(hd, float(rs), float(hs), float(cos_sun))) * glm::dvec3(t);
+        out.reflected_tables += sky_light * glm::dvec3(t);
     }
     return out;
 }
