@@ -54,9 +54,11 @@ glm::dvec3 extinction_at(const Atmosphere& atm, double h) {
     return e;
 }
 
+} // namespace
+
 // ∫_a^b extinction(x(t)) dt along origin + t dir: optical depth per channel.
-glm::dvec3 optical_depth(const Atmosphere& atm, const glm::dvec3& origin, const glm::dvec3& dir, double a, double b,
-                         double tolerance) {
+glm::dvec3 optical_depth_exact(const Atmosphere& atm, const glm::dvec3& origin, const glm::dvec3& dir, double a,
+                               double b, double tolerance) {
     if (!(b > a))
         return glm::dvec3(0.0);
     const RayAltitude alt(atm.planet_radius_km, origin, dir);
@@ -64,8 +66,6 @@ glm::dvec3 optical_depth(const Atmosphere& atm, const glm::dvec3& origin, const 
     const auto pts = graded_breakpoints(a, b, {a, b, alt.tangent()}, profile_scale(atm));
     return integrate_adaptive(f, pts, tolerance, 1e-15);
 }
-
-} // namespace
 
 bool atmosphere_segment(const Atmosphere& atm, const glm::dvec3& origin, const glm::dvec3& dir, double& enter,
                         double& exit, bool& hits_ground) {
@@ -101,7 +101,7 @@ glm::dvec3 sun_transmittance_exact(const Atmosphere& atm, const glm::dvec3& p, c
         return glm::dvec3(1.0);
     if (ground)
         return glm::dvec3(0.0);
-    return glm::exp(-optical_depth(atm, p, sun, enter, exit, 1e-10));
+    return glm::exp(-optical_depth_exact(atm, p, sun, enter, exit, 1e-10));
 }
 
 glm::dvec3 inscatter_exact(const Atmosphere& atm, const glm::dvec3& origin, const glm::dvec3& dir, double length,
@@ -127,7 +127,7 @@ glm::dvec3 inscatter_exact(const Atmosphere& atm, const glm::dvec3& origin, cons
         glm::dvec3 w(0.0);
         for (std::size_t k = 0; k < atm.components.size(); ++k)
             w += scatter[k] * relative_density(atm.components[k], h);
-        const glm::dvec3 tv = glm::exp(-optical_depth(atm, origin, dir, 0.0, v, inner_tol));
+        const glm::dvec3 tv = glm::exp(-optical_depth_exact(atm, origin, dir, 0.0, v, inner_tol));
         return w * ts * tv;
     };
 
@@ -147,7 +147,7 @@ glm::dvec3 inscatter_exact(const Atmosphere& atm, const glm::dvec3& origin, cons
     const auto pts = graded_breakpoints(0.0, length, {0.0, length, alt.tangent()}, profile_scale(atm), extra);
     const glm::dvec3 result = integrate_adaptive(f, pts, tolerance, 1e-300);
     if (transmittance)
-        *transmittance = glm::exp(-optical_depth(atm, origin, dir, 0.0, length, 1e-10));
+        *transmittance = glm::exp(-optical_depth_exact(atm, origin, dir, 0.0, length, 1e-10));
     return result;
 }
 

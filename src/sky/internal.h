@@ -34,6 +34,11 @@ glm::dvec3 inscatter_exact(const Atmosphere& atmosphere, const glm::dvec3& origi
 // Exact transmittance of sunlight reaching point_km (0 in the planet's shadow).
 glm::dvec3 sun_transmittance_exact(const Atmosphere& atmosphere, const glm::dvec3& point_km, const glm::dvec3& sun);
 
+// ∫_a^b extinction dt along origin_km + t dir (per channel), by adaptive
+// quadrature to the relative tolerance.
+glm::dvec3 optical_depth_exact(const Atmosphere& atmosphere, const glm::dvec3& origin_km, const glm::dvec3& dir,
+                               double a_km, double b_km, double tolerance);
+
 // Length of the view ray inside the atmosphere from origin_km along dir: the
 // entry distance (0 inside) and the exit or ground distance. False if it misses.
 bool atmosphere_segment(const Atmosphere& atmosphere, const glm::dvec3& origin_km, const glm::dvec3& dir,

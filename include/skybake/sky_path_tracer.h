@@ -1,0 +1,60 @@
+// A brute-force Monte Carlo path tracer of the atmosphere: the ground truth
+// of the multiple-scattering methods (see docs/sky.md, "Monte Carlo reference").
+//
+// Paths start at the observer and run backwards to the sun. Free flights use
+// delta (Woodcock) tracking against a constant majorant; the first collision
+// along the view ray is forced (its probability 1 − T is known exactly); each
+// scattering event adds the sun by next-event estimation with the exact
+// transmittance towards it; directions are drawn from the phase functions
+// (one-sample mixture over components); the ground is Lambertian at the
+// atmosphere's albedo. Russian roulette ends weak paths without bias.
+//
+// Orders: every scattering event, in the air or on the ground, is one order.
+// The sun reflected by the ground the view ray meets is not sky light and is
+// not counted (as in SkyModel). Results are per unit sun irradiance, 1/sr,
+// each channel traced on its own.
+//
+// Deterministic: path i of channel c draws from SplitMix64 seeded by (seed, c, i),
+// and partial sums are added in a fixed order, whatever the thread count.
+#pragma once
+
+#include <cstdint>
+
+#include <glm/vec3.hpp>
+
+#include "skybake/sky.h"
+
+namespace skybake {
+
+struct PathTracerOptions {
+    std::uint64_t paths = 1u << 16; // per channel, ≥ 2
+    std::uint64_t seed = 1;
+    int min_order = 1;              // count scattering orders min_order..max_order (1 ≤ min ≤ max)
+    int max_order = 1 << 20;
+};
+
+struct PathTracedRadiance {
+    glm::dvec3 mean{0.0};
+    glm::dvec3 standard_error{0.0}; // of the mean, per channel
+    std::uint64_t paths = 0;        // per channel
+};
+
+// The sky radiance an observer at radius_km (may be above the top) sees along
+// the view given by the three cosines (as SkyModel::radiance_at_radius).
+// Throws skybake::Error naming the field for bad options or cosines.
+PathTracedRadiance path_trace_sky(const Atmosphere& atmosphere, double radius_km, double cos_view_zenith,
+                                  double cos_view_sun, double cos_sun_zenith, const PathTracerOptions& options = {});
+
+// The albedo problem: a semi-infinite plane-parallel slab of constant density
+// and isotropic phase, with single-scattering albedo ϖ, lit by a parallel beam
+// of unit irradiance (normal to the beam) from direction cosine mu_sun. The
+// radiance it reflects towards direction cosine mu_view, all orders, is
+// Chandrasekhar's (ϖ/4π) μ0/(μ+μ0) H(μ) H(μ0): the path tracer's own test.
+struct SlabMedium {
+    double single_scattering_albedo = 0.9; // ϖ in (0, 1]
+};
+// The result is the same in every channel.
+PathTracedRadiance path_trace_slab_reflection(const SlabMedium& slab, double mu_view, double mu_sun,
+                                              const PathTracerOptions& options = {});
+
+} // namespace skybake
