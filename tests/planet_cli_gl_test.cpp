@@ -153,6 +153,40 @@ void expect_one_line_failure(const test::CliResult& r, const std::string& out, c
     EXPECT_FALSE(fs::exists(out));
 }
 
+// Multiple scattering in GLSL (the orders grid, Hillaire's march, the sky
+// irradiance on the ground) against the CPU renderer: from the ground at
+// sunset (twilight colours, where the multiple part is largest) and from orbit.
+TEST(PlanetCli, GlMultipleScatteringMatchesCpu) {
+    const std::string dir = test::temp_dir("planet_multiple");
+    struct Case {
+        const char *method, *alt, *sun, *pitch, *orders;
+    };
+    for (const Case& c : {Case{"hillaire", "0", "2", "10", nullptr}, Case{"hillaire", "1500", "20", "-60", nullptr},
+                          Case{"orders", "1500", "20", "-60", "2"}}) {
+        std::vector<std::string> args = {"sky", "render", "--preset", "earth", "--scattering", "multiple",
+                                         "--multiple-method", c.method, "--altitude-km", c.alt,
+                                         "--sun-elevation-deg", c.sun, "--view", "camera", "--pitch", c.pitch,
+                                         "--size", "160x120", "-q"};
+        if (c.orders)
+            args.insert(args.end(), {"--scattering-orders", c.orders});
+        args.push_back("-o");
+        auto cpu = args, gl = args;
+        cpu.push_back(dir + "/cpu.exr");
+        gl.insert(gl.end(), {dir + "/gl.exr", "--renderer", "gl", "--shading", "pixel"});
+        auto rc = run_cli(cpu);
+        ASSERT_EQ(rc.exit_code, 0) << rc.err;
+        auto r = run_cli(gl);
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        const Image a = load_image(dir + "/cpu.exr"), b = load_image(dir + "/gl.exr");
+        ToneMap tm;
+        tm.exposure_ev = float(auto_exposure_ev(a));
+        const double psnr = image_psnr_db(a, b, tm);
+        std::printf("multiple scattering (%s), %s km: gl per pixel %.2f dB\n", c.method, c.alt, psnr);
+        std::fflush(stdout);
+        EXPECT_GE(psnr, 30.0) << c.method << " " << c.alt;
+    }
+}
+
 TEST(PlanetCli, NoEglPlatformIsOneLine) {
     const std::string out = test::temp_dir("planet_noegl") + "/x.png";
     auto args = view_args(kViews[0], out);

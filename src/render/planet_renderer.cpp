@@ -138,6 +138,40 @@ PlanetScene::PlanetScene(const GlContext& context, const SkyModel& model, const 
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
 
+    // Multiple scattering: the orders grid or ψms, then the sky irradiance, as
+    // RGB triples in one buffer texture (always bound, empty or not, so that
+    // the sampler never shares unit 0 with the tables).
+    {
+        const sky::MultipleHD& m = sky::atmosphere_hd(model).ms;
+        std::vector<float> ms;
+        if (m.orders)
+            ms.assign(m.orders, m.orders + std::size_t(m.nr) * 2u * std::size_t(m.nmu) * std::size_t(m.nmus) *
+                                               std::size_t(m.nnu) * 3u);
+        ms_psi_first_ = int(ms.size() / 3);
+        if (m.psi)
+            ms.insert(ms.end(), m.psi, m.psi + std::size_t(m.psi_nr) * std::size_t(m.psi_nmus) * 3u);
+        ms_irr_first_ = int(ms.size() / 3);
+        if (m.irradiance)
+            ms.insert(ms.end(), m.irradiance, m.irradiance + std::size_t(m.irr_nr) * std::size_t(m.irr_nmus) * 3u);
+        if (ms.empty())
+            ms.assign(3, 0.0f);
+        GLint max_texels = 0;
+        glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+        if (GLint(ms.size()) > max_texels)
+            throw Error(fmt::format("the multiple-scattering tables need {} texels of a buffer texture; this driver "
+                                    "allows {}",
+                                    ms.size(), max_texels),
+                        "OpenGL");
+        ms_buf_ = make_buffer();
+        glBindBuffer(GL_TEXTURE_BUFFER, ms_buf_.get());
+        glBufferData(GL_TEXTURE_BUFFER, GLsizeiptr(ms.size() * sizeof(float)), ms.data(), GL_STATIC_DRAW);
+        ms_tex_ = make_texture();
+        glBindTexture(GL_TEXTURE_BUFFER, ms_tex_.get());
+        glTexBuffer(GL_TEXTURE_BUFFER, GL_R32F, ms_buf_.get());
+        glBindTexture(GL_TEXTURE_BUFFER, 0);
+        glBindBuffer(GL_TEXTURE_BUFFER, 0);
+    }
+
     // Sky shell directions (per vertex) and the mesh buffers.
     empty_vao_ = make_vertex_array();
     // Sky dome (per vertex, inside the atmosphere): rings of constant angle to
@@ -232,6 +266,18 @@ void PlanetScene::set_uniforms(GLuint p, const PlanetView& v, const Basis& b) co
     glUniform1i(loc(p, "u_tables"), 0);
     glUniform1i(loc(p, "u_rows"), rows_);
     glUniform1i(loc(p, "u_cols"), cols_);
+    {
+        const sky::MultipleHD& m = sky::atmosphere_hd(model_).ms;
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_BUFFER, ms_tex_.get());
+        glActiveTexture(GL_TEXTURE0);
+        glUniform1i(loc(p, "u_ms"), 1);
+        glUniform1i(loc(p, "u_ms_method"), m.method);
+        glUniform4i(loc(p, "u_ms_grid"), m.nr, m.nmu, m.nmus, m.nnu);
+        glUniform1f(loc(p, "u_ms_mu_s_min"), m.mu_s_min);
+        glUniform3i(loc(p, "u_ms_psi"), ms_psi_first_, m.psi ? m.psi_nr : 0, m.psi ? m.psi_nmus : 0);
+        glUniform3i(loc(p, "u_ms_irr"), ms_irr_first_, m.irradiance ? m.irr_nr : 0, m.irradiance ? m.irr_nmus : 0);
+    }
     const glm::dvec3 eye = shading_eye(v);
     const double r = glm::length(eye);
     glUniform1f(loc(p, "u_eye_r"), float(r));

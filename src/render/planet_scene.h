@@ -49,6 +49,10 @@ private:
     Buffer weights_;
     Texture tables_;
     int rows_ = 0, cols_ = 0;
+    // Multiple scattering: the SkyModel's tables in one R32F buffer texture (unit 1).
+    Buffer ms_buf_;
+    Texture ms_tex_;
+    int ms_psi_first_ = 0, ms_irr_first_ = 0;
     VertexArray empty_vao_, dome_vao_, mesh_vao_;
     Buffer dome_vbo_, dome_ibo_, pos_vbo_, nrm_vbo_, mesh_ibo_;
     VertexArray shell_vao_;

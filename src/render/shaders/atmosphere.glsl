@@ -184,11 +184,97 @@ vec3 sb_sun_transmittance(float r, float h, float cos_sun_zenith) {
     return sb_exp3(tau);
 }
 
+// ---- multiple scattering (sky/multiple_hd.h) ----------------------------------------------
+uniform int u_ms_method;        // 0 none, 1 orders, 2 hillaire (sky::kMultiple*)
+uniform samplerBuffer u_ms;     // R32F, RGB triples: the orders grid, then ψms, then the sky irradiance
+uniform ivec4 u_ms_grid;        // orders: nr, nmu (per half), nmus, nnu
+uniform float u_ms_mu_s_min;
+uniform ivec3 u_ms_psi;         // ψms: first triple, nr, nmus
+uniform ivec3 u_ms_irr;         // sky irradiance: first triple, nr, nmus (nr 0: none)
+
+vec3 sb_ms_fetch(int i) {
+    return vec3(texelFetch(u_ms, 3 * i).r, texelFetch(u_ms, 3 * i + 1).r, texelFetch(u_ms, 3 * i + 2).r);
+}
+
+float sb_distance_to_top(float r, float mu, float Rt) {
+    return -r * mu + sqrt(max(r * r * (mu * mu - 1.0) + Rt * Rt, 0.0));
+}
+
+// grid_axis: cell index and fraction of x in [0, 1] over n nodes.
+int sb_grid_axis(float x, int n, out float f) {
+    float s = max(x * float(n - 1), 0.0);
+    int i = min(int(s), n - 2);
+    f = min(s - float(i), 1.0);
+    return i;
+}
+
+// orders_lookup(): grid4_coordinates, then the quadrilinear grid4_lookup.
+vec3 sb_orders_lookup(float r, float mu, float mu_s, float nu) {
+    float R0 = u_R0, Rt = u_Rtop;
+    float H = sqrt(max(Rt * Rt - R0 * R0, 0.0));
+    r = clamp(r, R0, Rt);
+    float rho = sqrt(max(r * r - R0 * R0, 0.0));
+    float xr = rho / H, xmu;
+    float rmu = r * mu;
+    float disc = rmu * rmu - r * r + R0 * R0;
+    int ground = mu < 0.0 && disc >= 0.0 ? 1 : 0;
+    if (ground == 1) {
+        float d = -rmu - sqrt(max(disc, 0.0));
+        float dmin = r - R0, dmax = rho;
+        xmu = dmax > dmin ? clamp((d - dmin) / (dmax - dmin), 0.0, 1.0) : 0.0;
+    } else {
+        float d = -rmu + sqrt(max(disc + H * H, 0.0));
+        float dmin = Rt - r, dmax = rho + H;
+        xmu = clamp((d - dmin) / (dmax - dmin), 0.0, 1.0);
+    }
+    float dmin = Rt - R0, dmax = H;
+    float a = (sb_distance_to_top(R0, mu_s, Rt) - dmin) / (dmax - dmin);
+    float A = (sb_distance_to_top(R0, u_ms_mu_s_min, Rt) - dmin) / (dmax - dmin);
+    float x = 1.0 - a / A;
+    float xmus = clamp((x > 0.0 ? x : 0.0) / (1.0 + a), 0.0, 1.0);
+    float xnu = clamp((nu + 1.0) * 0.5, 0.0, 1.0);
+    int nr = u_ms_grid.x, nmu = u_ms_grid.y, nmus = u_ms_grid.z, nnu = u_ms_grid.w;
+    float fr, fm, fs, fn;
+    int ir = sb_grid_axis(xr, nr, fr), im = sb_grid_axis(xmu, nmu, fm), is = sb_grid_axis(xmus, nmus, fs),
+        in_ = sb_grid_axis(xnu, nnu, fn);
+    vec3 sum = vec3(0.0);
+    for (int ia = 0; ia < 2; ++ia)
+        for (int ib = 0; ib < 2; ++ib)
+            for (int isu = 0; isu < 2; ++isu)
+                for (int inu = 0; inu < 2; ++inu) {
+                    float w = (ia == 1 ? fr : 1.0 - fr) * (ib == 1 ? fm : 1.0 - fm) * (isu == 1 ? fs : 1.0 - fs) *
+                              (inu == 1 ? fn : 1.0 - fn);
+                    int idx = ((((ir + ia) * 2 + ground) * nmu + im + ib) * nmus + is + isu) * nnu + in_ + inu;
+                    sum += w * sb_ms_fetch(idx);
+                }
+    return sum;
+}
+
+// altitude_sun_lookup(): bilinear over (h / (Rt − R0), (μs + 1) / 2).
+vec3 sb_altitude_sun_lookup(ivec3 t, float h, float mu_s) {
+    float fr, fs;
+    int i = sb_grid_axis(clamp(h / (u_Rtop - u_R0), 0.0, 1.0), t.y, fr);
+    int j = sb_grid_axis(clamp(0.5 * (mu_s + 1.0), 0.0, 1.0), t.z, fs);
+    vec3 v = vec3(0.0);
+    for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b) {
+            float w = (a == 1 ? fr : 1.0 - fr) * (b == 1 ? fs : 1.0 - fs);
+            v += w * sb_ms_fetch(t.x + (i + a) * t.z + (j + b));
+        }
+    return v;
+}
+
+// The scattered sky light on a horizontal surface (0 without multiple scattering).
+vec3 sb_sky_irradiance(float h, float mu_s) {
+    return u_ms_irr.y > 0 ? sb_altitude_sun_lookup(u_ms_irr, h, mu_s) : vec3(0.0);
+}
+
 #ifdef SKYBAKE_SKY_REFERENCE
 // ---- the seed's marching sum (sky::seed_sky_sum) -----------------------------------
 vec3 sb_scatter[SKYBAKE_MAX_COMPONENTS];
 float sb_l_obs[SKYBAKE_MAX_COMPONENTS];
 float sb_base;
+vec3 sb_ms_result; // Hillaire's part of the current sum
 
 void sb_sum_point(SbObserver o, float v, float dv, inout vec3 result) {
     float d2 = sb_base + v * (v + 2.0 * o.r * o.cv);
@@ -198,6 +284,16 @@ void sb_sum_point(SbObserver o, float v, float dv, inout vec3 result) {
     float inv_r = 1.0 / rv;
     float cav = min(max((o.r * o.cv + v) * inv_r, -1.0), 1.0);
     float cth = min(max((o.r * o.cs + v * o.cvs) * inv_r, -1.0), 1.0);
+    if (u_ms_method == 2) { // Hillaire's march (sky::HillairePoint), shadowed or not
+        vec3 tau_v = vec3(0.0), sigma_s = vec3(0.0);
+        for (int k = 0; k < u_count; ++k) {
+            float rho = sb_density(k, hv);
+            float u = sb_table_coordinate(k, hv, rho);
+            tau_v += u_ext[k] * (sb_l_obs[k] - sb_optical_length(k, rv, u, cav));
+            sigma_s += u_sca[k] * rho;
+        }
+        sb_ms_result += sigma_s * sb_altitude_sun_lookup(u_ms_psi, hv, cth) * (dv * sb_exp3(tau_v));
+    }
     if (sb_in_planet_shadow(rv, cth, u_R0))
         return;
     vec3 tau = vec3(0.0), weight = vec3(0.0);
@@ -267,6 +363,29 @@ vec3 sb_seed_sky_sum(SbObserver o, float limit) {
     sb_sum_graded(o, v_low, after, 1.0, s, u_steps - nb, result);
     return result;
 }
+
+// sky::sky_sum(): the seed's sum plus the multiple-scattering part. limit as
+// sb_seed_sky_sum; with the orders grid, the part beyond a surface at `limit`
+// is the grid there times the transmittance in between (Bruneton's aerial perspective).
+vec3 sb_sky_sum(SbObserver o, float limit) {
+    sb_ms_result = vec3(0.0);
+    vec3 c = sb_seed_sky_sum(o, limit);
+    if (u_ms_method == 2)
+        c += sb_ms_result;
+    SbObserver e = o;
+    if (u_ms_method == 1 && sb_enter_atmosphere(e)) {
+        vec3 ms = sb_orders_lookup(e.r, e.cv, e.cs, e.cvs);
+        if (limit >= 0.0) {
+            float rp = sqrt(max(o.r * o.r + limit * limit + 2.0 * o.r * limit * o.cv, 0.0));
+            float mup = clamp((o.r * o.cv + limit) / rp, -1.0, 1.0);
+            float musp = clamp((o.r * o.cs + limit * o.cvs) / rp, -1.0, 1.0);
+            vec3 t = sb_segment_transmittance(e.r, e.h, e.cv, rp, rp - u_R0, mup);
+            ms = max(ms - t * sb_orders_lookup(rp, mup, musp, o.cvs), vec3(0.0));
+        }
+        c += ms;
+    }
+    return c;
+}
 #endif
 
 // ---- per-ray shading (sky::shade_ray / neural::shade_ray_neural) ---------------------
@@ -279,7 +398,7 @@ vec3 sb_shade_ray(vec3 d, out vec3 sun_t) {
     bool inside = sb_enter_atmosphere(e);
     vec3 c = vec3(0.0);
 #ifdef SKYBAKE_SKY_REFERENCE
-    c = sb_seed_sky_sum(o, -1.0);
+    c = sb_sky_sum(o, -1.0);
 #else
     if (inside)
         c = skybake_sky(e.cv, e.cvs, e.cs, sb_density(0, e.h));
@@ -297,8 +416,11 @@ vec3 sb_shade_ray(vec3 d, out vec3 sun_t) {
         if (inside)
             c = max(c - skybake_sky(dot(n, d), o.cvs, cos_sun, 1.0), vec3(0.0));
 #endif
-        if (cos_sun > 0.0) {
-            vec3 reflected = u_albedo * (cos_sun / SKYBAKE_PI) * sb_sun_transmittance(u_R0, 0.0, cos_sun);
+        if (cos_sun > 0.0 || u_ms_irr.y > 0) {
+            vec3 reflected = vec3(0.0);
+            if (cos_sun > 0.0)
+                reflected = u_albedo * (cos_sun / SKYBAKE_PI) * sb_sun_transmittance(u_R0, 0.0, cos_sun);
+            reflected += u_albedo * (1.0 / SKYBAKE_PI) * sb_sky_irradiance(0.0, cos_sun); // multiple scattering
             if (u_published_ground != 0) {
                 vec3 bs = vec3(0.0);
                 for (int k = 0; k < u_count; ++k)
@@ -326,7 +448,7 @@ vec3 sb_shade_ground(vec3 d, vec3 g, vec3 nrm, float h_g, float dist) {
     float cos_sun_g = dot(up_g, u_sun);
     vec3 c = vec3(0.0);
 #ifdef SKYBAKE_SKY_REFERENCE
-    c = sb_seed_sky_sum(o, h_g > 0.0 ? dist : -1.0);
+    c = sb_sky_sum(o, h_g > 0.0 ? dist : -1.0);
 #else
     if (inside) {
         c = skybake_sky(e.cv, e.cvs, e.cs, sb_density(0, e.h));
@@ -334,8 +456,11 @@ vec3 sb_shade_ground(vec3 d, vec3 g, vec3 nrm, float h_g, float dist) {
     }
 #endif
     float cos_sun = dot(nrm, u_sun);
-    if (cos_sun > 0.0) {
-        vec3 reflected = u_albedo * (cos_sun / SKYBAKE_PI) * sb_sun_transmittance(r_g, h_g, cos_sun_g);
+    if (cos_sun > 0.0 || u_ms_irr.y > 0) {
+        vec3 reflected = vec3(0.0);
+        if (cos_sun > 0.0)
+            reflected = u_albedo * (cos_sun / SKYBAKE_PI) * sb_sun_transmittance(r_g, h_g, cos_sun_g);
+        reflected += u_albedo * (1.0 / SKYBAKE_PI) * sb_sky_irradiance(h_g, cos_sun_g); // multiple scattering
         if (u_published_ground != 0) {
             vec3 bs = vec3(0.0);
             for (int k = 0; k < u_count; ++k)
