@@ -215,3 +215,107 @@ TEST(SkyCli, RenderWritesImages) {
     EXPECT_EQ(bad.exit_code, 2);
     EXPECT_EQ(bad.err_lines(), 1);
 }
+
+namespace {
+
+std::vector<std::array<double, 3>> read_rgb_csv(const std::string& path) {
+    std::istringstream rows(read(path));
+    std::string line;
+    std::getline(rows, line);
+    std::vector<std::array<double, 3>> v;
+    while (std::getline(rows, line)) {
+        std::array<double, 3> c{};
+        if (std::sscanf(line.c_str(), "%lf,%lf,%lf", &c[0], &c[1], &c[2]) == 3)
+            v.push_back(c);
+    }
+    return v;
+}
+
+} // namespace
+
+// --scattering multiple adds light everywhere, and most where single
+// scattering has none: the zenith with the sun 10° below the horizon (the whole column in the shadow).
+TEST(SkyCli, EvalWithMultipleScatteringAddsLight) {
+    const std::string dir = temp_dir("sky_eval_multiple");
+    const std::string in = write(dir, "in.csv",
+                                 "cos_view_zenith,cos_view_sun,cos_sun_zenith,density\n"
+                                 "1,0.866,0.866,1\n"     // noon-ish zenith
+                                 "1,-0.1736,-0.1736,1\n"); // twilight zenith, sun at -10°
+    std::vector<std::array<double, 3>> single, multiple;
+    for (const char* mode : {"single", "multiple"}) {
+        const std::string out = dir + "/" + mode + ".csv";
+        auto r = run_cli({"sky", "eval", "--preset", "earth", "--method", "exact", "--scattering", mode,
+                          "--multiple-method", "hillaire", "--input", in, "--output", out});
+        if (std::string(mode) == "single") {
+            EXPECT_EQ(r.exit_code, 2) << "--multiple-method needs --scattering multiple";
+            EXPECT_EQ(r.err_lines(), 1) << r.err;
+            EXPECT_NE(r.err.find("--multiple-method"), std::string::npos) << r.err;
+            r = run_cli({"sky", "eval", "--preset", "earth", "--method", "exact", "--input", in, "--output", out});
+        }
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        (std::string(mode) == "single" ? single : multiple) = read_rgb_csv(out);
+    }
+    ASSERT_EQ(single.size(), 2u);
+    ASSERT_EQ(multiple.size(), 2u);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_GT(multiple[0][c], 1.05 * single[0][c]) << c;
+        EXPECT_LT(multiple[0][c], 2.0 * single[0][c]) << c;
+        EXPECT_EQ(single[1][c], 0.0);
+        EXPECT_GT(multiple[1][c], 0.0) << c;
+    }
+    EXPECT_GT(multiple[1][2], multiple[1][0]); // the twilight zenith stays blue
+}
+
+TEST(SkyCli, MultipleScatteringFlagsAreChecked) {
+    const std::string dir = temp_dir("sky_multiple_flags");
+    const std::string light = dir + "/light.json";
+    struct Case {
+        std::vector<std::string> args;
+        const char* names;
+    } cases[] = {
+        {{"sky", "sh", "--scattering", "double", "-o", light}, "--scattering"},
+        {{"sky", "sh", "--multiple-method", "bruneton", "--scattering", "multiple", "-o", light}, "--multiple-method"},
+        {{"sky", "sh", "--scattering", "multiple", "--multiple-method", "hillaire", "--scattering-orders", "8", "-o",
+          light},
+         "--scattering-orders"},
+        {{"sky", "sh", "--scattering-orders", "8", "-o", light}, "--scattering-orders"},
+        {{"sky", "sh", "--scattering", "multiple", "--scattering-orders", "1", "-o", light}, "--scattering-orders"},
+    };
+    for (const Case& c : cases) {
+        auto r = run_cli(c.args);
+        EXPECT_NE(r.exit_code, 0) << c.names;
+        EXPECT_EQ(r.err_lines(), 1) << r.err;
+        EXPECT_NE(r.err.find(c.names), std::string::npos) << r.err;
+        EXPECT_FALSE(std::filesystem::exists(light));
+    }
+}
+
+// The sky's SH light with multiple scattering is brighter in every band-0
+// channel, and bluer; the training target is reported.
+TEST(SkyCli, ShAndTrainUseTheFullSky) {
+    const std::string dir = temp_dir("sky_sh_multiple");
+    std::array<double, 3> dc[2];
+    for (int m = 0; m < 2; ++m) {
+        const std::string out = dir + (m ? "/multiple.json" : "/single.json");
+        std::vector<std::string> args = {"sky", "sh", "--preset", "earth", "--order", "1", "--rule", "lebedev:590",
+                                         "-o", out};
+        if (m)
+            args.insert(args.end(), {"--scattering", "multiple", "--multiple-method", "hillaire"});
+        auto r = run_cli(args);
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        const auto j = nlohmann::json::parse(read(out));
+        for (int c = 0; c < 3; ++c)
+            dc[m][std::size_t(c)] = j["coefficients"][0][c].get<double>();
+    }
+    for (int c = 0; c < 3; ++c)
+        EXPECT_GT(dc[1][std::size_t(c)], 1.05 * dc[0][std::size_t(c)]) << c;
+    EXPECT_GT(dc[1][2] / dc[0][2], dc[1][0] / dc[0][0]); // multiple scattering is bluest
+
+    auto t = run_cli({"sky", "train", "--preset", "earth", "--scattering", "multiple", "--multiple-method", "hillaire",
+                      "--samples", "4000", "--epochs", "1", "-o", dir + "/w.json", "--json", "-q"});
+    ASSERT_EQ(t.exit_code, 0) << t.err;
+    const auto j = nlohmann::json::parse(t.out);
+    EXPECT_NE(j["target"].get<std::string>().find("single + multiple"), std::string::npos);
+    const auto w = nlohmann::json::parse(read(dir + "/w.json"));
+    EXPECT_NE(w.dump().find("\"scattering\":\"multiple\""), std::string::npos);
+}

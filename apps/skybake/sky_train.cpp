@@ -104,12 +104,19 @@ void add_sky_train(CLI::App& group) {
                                     fmt::format("{} on {}, {} samples", net.topology.name(), atm.name, o->t.samples));
         files.commit();
         const NeuralTrainingSummary& s = net.training;
-        info("trained {} ({} weights) on {} samples of '{}' in {:.1f} s ({} threads): held-out RMS {:.4g}, "
+        // What the network learns: with multiple scattering, the total radiance
+        // (single + multiple, as SkyModel gives it), not a residual.
+        const std::string target =
+            atm.scattering == Scattering::Multiple
+                ? fmt::format("total radiance, single + multiple ({})", multiple_scattering_method_name(atm.multiple_method))
+                : std::string("single-scattered radiance");
+        info("trained {} ({} weights) on {} samples of '{}' ({}) in {:.1f} s ({} threads): held-out RMS {:.4g}, "
              "mean relative error {:.3g}% -> {}",
-             net.topology.name(), net.topology.weight_count(), s.samples, atm.name, s.seconds, s.threads,
+             net.topology.name(), net.topology.weight_count(), s.samples, atm.name, target, s.seconds, s.threads,
              s.heldout_rms, 100.0 * s.heldout_mean_relative, o->output);
         if (o->json)
             print_json({{"atmosphere", atm.name},
+                        {"target", target},
                         {"topology", net.topology.name()},
                         {"weights", net.topology.weight_count()},
                         {"brightness", o->brightness},
