@@ -2,6 +2,9 @@
 // counts) and the exact quadrature, on random valid samples of the input
 // space. The baseline is the tables path at the default 16 steps; counters
 // report samples/s and, for the others, the ratio to that baseline.
+// Multiple scattering (Earth, 16 steps): the precomputation of each method
+// (seconds, table bytes) and its samples/s, beside single scattering's in
+// the same run (BM_SkyTablesEarth/16 is its baseline).
 #include <benchmark/benchmark.h>
 
 #include "skybake/sky.h"
@@ -44,10 +47,48 @@ void BM_SkyExactPaper(benchmark::State& state) {
         benchmark::Counter(double(s.size()) * double(state.iterations()), benchmark::Counter::kIsRate);
 }
 
+Atmosphere earth_multiple(MultipleScatteringMethod method) {
+    Atmosphere a = atmosphere_preset("earth");
+    a.scattering = Scattering::Multiple;
+    a.multiple_method = method;
+    return a;
+}
+
+// The constructor's multiple-scattering tables (orders: 4, the default).
+void BM_SkyMultiplePrecompute(benchmark::State& state) {
+    const auto method = MultipleScatteringMethod(state.range(0));
+    state.SetLabel(multiple_scattering_method_name(method));
+    double seconds = 0.0, bytes = 0.0;
+    for (auto _ : state) {
+        const SkyModel model(earth_multiple(method));
+        seconds = model.multiple_precompute_seconds();
+        bytes = double(model.multiple_table_bytes());
+    }
+    state.counters["table_bytes"] = bytes;
+    state.counters["precompute_s"] = seconds;
+}
+
+void BM_SkyMultipleTables(benchmark::State& state) {
+    const auto method = MultipleScatteringMethod(state.range(0));
+    state.SetLabel(multiple_scattering_method_name(method));
+    const SkyModel model(earth_multiple(method));
+    const auto& s = samples();
+    std::vector<glm::vec3> out(s.size());
+    for (auto _ : state) {
+        evaluate_sky(model, s, out, SkyMethod::Tables);
+        benchmark::DoNotOptimize(out.data());
+    }
+    state.counters["samples_per_s"] =
+        benchmark::Counter(double(s.size()) * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+
 } // namespace
 
 BENCHMARK(BM_SkyTablesPaper)->Arg(8)->Arg(16)->Arg(32)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SkyTablesEarth)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SkyExactPaper)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+
+BENCHMARK(BM_SkyMultiplePrecompute)->Arg(0)->Arg(1)->Unit(benchmark::kSecond)->UseRealTime()->Iterations(1);
+BENCHMARK(BM_SkyMultipleTables)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 BENCHMARK_MAIN();
