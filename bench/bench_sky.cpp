@@ -18,18 +18,22 @@ const std::vector<SkySample>& samples() {
     return s;
 }
 
-void run_tables(benchmark::State& state, const char* preset) {
-    SkyModelOptions o;
-    o.steps = int(state.range(0));
-    const SkyModel model(atmosphere_preset(preset), o);
-    const auto& s = samples();
+// Times evaluate_sky over `s` and reports samples/s.
+void time_evaluate(benchmark::State& state, const SkyModel& model, const std::vector<SkySample>& s, SkyMethod method) {
     std::vector<glm::vec3> out(s.size());
     for (auto _ : state) {
-        evaluate_sky(model, s, out, SkyMethod::Tables);
+        evaluate_sky(model, s, out, method);
         benchmark::DoNotOptimize(out.data());
     }
     state.counters["samples_per_s"] =
         benchmark::Counter(double(s.size()) * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+
+void run_tables(benchmark::State& state, const char* preset) {
+    SkyModelOptions o;
+    o.steps = int(state.range(0));
+    const SkyModel model(atmosphere_preset(preset), o);
+    time_evaluate(state, model, samples(), SkyMethod::Tables);
 }
 
 void BM_SkyTablesPaper(benchmark::State& state) { run_tables(state, "paper"); }
@@ -38,13 +42,7 @@ void BM_SkyTablesEarth(benchmark::State& state) { run_tables(state, "earth"); }
 void BM_SkyExactPaper(benchmark::State& state) {
     const SkyModel model(atmosphere_preset("paper"));
     const std::vector<SkySample> s(samples().begin(), samples().begin() + 200);
-    std::vector<glm::vec3> out(s.size());
-    for (auto _ : state) {
-        evaluate_sky(model, s, out, SkyMethod::Exact);
-        benchmark::DoNotOptimize(out.data());
-    }
-    state.counters["samples_per_s"] =
-        benchmark::Counter(double(s.size()) * double(state.iterations()), benchmark::Counter::kIsRate);
+    time_evaluate(state, model, s, SkyMethod::Exact);
 }
 
 Atmosphere earth_multiple(MultipleScatteringMethod method) {
@@ -72,14 +70,7 @@ void BM_SkyMultipleTables(benchmark::State& state) {
     const auto method = MultipleScatteringMethod(state.range(0));
     state.SetLabel(multiple_scattering_method_name(method));
     const SkyModel model(earth_multiple(method));
-    const auto& s = samples();
-    std::vector<glm::vec3> out(s.size());
-    for (auto _ : state) {
-        evaluate_sky(model, s, out, SkyMethod::Tables);
-        benchmark::DoNotOptimize(out.data());
-    }
-    state.counters["samples_per_s"] =
-        benchmark::Counter(double(s.size()) * double(state.iterations()), benchmark::Counter::kIsRate);
+    time_evaluate(state, model, samples(), SkyMethod::Tables);
 }
 
 } // namespace

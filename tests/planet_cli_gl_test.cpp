@@ -101,6 +101,25 @@ TEST(PlanetCli, GlMatchesCpuOnTheSeedViews) {
     std::fflush(stdout);
 }
 
+// Renders `args` (a `sky render` command line ending in "-o") with the CPU
+// renderer and with `--renderer gl --shading pixel`; the PSNR of the GL image
+// (tone-mapped at the CPU image's exposure), or a negative value on failure.
+double gl_against_cpu_psnr(std::vector<std::string> args, const std::string& dir) {
+    auto cpu = args, gl = args;
+    cpu.push_back(dir + "/cpu.exr");
+    gl.insert(gl.end(), {dir + "/gl.exr", "--renderer", "gl", "--shading", "pixel"});
+    const auto rc = run_cli(cpu);
+    EXPECT_EQ(rc.exit_code, 0) << rc.err;
+    const auto r = run_cli(gl);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    if (rc.exit_code != 0 || r.exit_code != 0)
+        return -1.0;
+    const Image a = load_image(dir + "/cpu.exr"), b = load_image(dir + "/gl.exr");
+    ToneMap tm;
+    tm.exposure_ev = float(auto_exposure_ev(a));
+    return image_psnr_db(a, b, tm);
+}
+
 // The reference sum in GLSL against the CPU's sum on the same tables.
 TEST(PlanetCli, GlReferenceSumMatchesCpu) {
     const std::string dir = test::temp_dir("planet_reference");
@@ -123,16 +142,7 @@ TEST(PlanetCli, GlReferenceSumMatchesCpu) {
                                          "160x120",
                                          "-q",
                                          "-o"};
-        auto cpu = args, gl = args;
-        cpu.push_back(dir + "/cpu.exr");
-        gl.insert(gl.end(), {dir + "/gl.exr", "--renderer", "gl", "--shading", "pixel"});
-        ASSERT_EQ(run_cli(cpu).exit_code, 0);
-        auto r = run_cli(gl);
-        ASSERT_EQ(r.exit_code, 0) << r.err;
-        const Image a = load_image(dir + "/cpu.exr"), b = load_image(dir + "/gl.exr");
-        ToneMap tm;
-        tm.exposure_ev = float(auto_exposure_ev(a));
-        const double psnr = image_psnr_db(a, b, tm);
+        const double psnr = gl_against_cpu_psnr(args, dir);
         std::printf("reference sum, %s km: gl per pixel %.2f dB\n", alt, psnr);
         std::fflush(stdout);
         EXPECT_GE(psnr, 30.0);
@@ -170,17 +180,7 @@ TEST(PlanetCli, GlMultipleScatteringMatchesCpu) {
         if (c.orders)
             args.insert(args.end(), {"--scattering-orders", c.orders});
         args.push_back("-o");
-        auto cpu = args, gl = args;
-        cpu.push_back(dir + "/cpu.exr");
-        gl.insert(gl.end(), {dir + "/gl.exr", "--renderer", "gl", "--shading", "pixel"});
-        auto rc = run_cli(cpu);
-        ASSERT_EQ(rc.exit_code, 0) << rc.err;
-        auto r = run_cli(gl);
-        ASSERT_EQ(r.exit_code, 0) << r.err;
-        const Image a = load_image(dir + "/cpu.exr"), b = load_image(dir + "/gl.exr");
-        ToneMap tm;
-        tm.exposure_ev = float(auto_exposure_ev(a));
-        const double psnr = image_psnr_db(a, b, tm);
+        const double psnr = gl_against_cpu_psnr(args, dir);
         std::printf("multiple scattering (%s), %s km: gl per pixel %.2f dB\n", c.method, c.alt, psnr);
         std::fflush(stdout);
         EXPECT_GE(psnr, 30.0) << c.method << " " << c.alt;
