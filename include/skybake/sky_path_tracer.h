@@ -41,7 +41,9 @@ struct PathTracedRadiance {
 
 // The sky radiance an observer at radius_km (may be above the top) sees along
 // the view given by the three cosines (as SkyModel::radiance_at_radius).
-// Throws skybake::Error naming the field for bad options or cosines.
+// The orders traced are the options' (the atmosphere's `scattering` fields
+// are not read). Throws skybake::Error naming the field for bad options or
+// cosines, and for a view ray whose optical depth is below 1e-6.
 PathTracedRadiance path_trace_sky(const Atmosphere& atmosphere, double radius_km, double cos_view_zenith,
                                   double cos_view_sun, double cos_sun_zenith, const PathTracerOptions& options = {});
 

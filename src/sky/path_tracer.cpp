@@ -405,6 +405,10 @@ PathTracedRadiance path_trace_sky(const Atmosphere& atm, double radius_km, doubl
     glm::dvec3 p(0.0);
     if (sky::atmosphere_segment(atm, O, V, ray.enter, ray.exit, ground))
         p = glm::dvec3(1.0) - glm::exp(-sky::optical_depth_exact(atm, O, V, ray.enter, ray.exit, 1e-12));
+    for (int c = 0; c < 3; ++c)
+        if (p[c] > 0.0 && p[c] < 1e-6)
+            throw Error("the view ray's optical depth is below 1e-6: too thin to trace a collision in it",
+                        "path tracer");
     return run_paths(opt, 3, [&](int c) {
         PrimaryRay r = ray;
         r.collision_probability = p[c];
