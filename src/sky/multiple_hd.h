@@ -134,10 +134,23 @@ SKYBAKE_HD_INLINE T grid4_lookup(const V* values, int stride, int j, int nr, int
 // Orders ≥ 2 at a point inside the atmosphere (r ≤ Rt), per unit sun irradiance.
 SKYBAKE_HD_INLINE glm::vec3 orders_lookup(const MultipleHD& m, float R0, float Rt, float r, float mu, float mu_s,
                                           float nu) {
+    // grid4_lookup for the three channels at once (same weights, same order of sums).
     const Grid4Coord<float> c = grid4_coordinates(R0, Rt, m.mu_s_min, r, mu, mu_s, nu);
-    return glm::vec3(grid4_lookup(m.orders, 3, 0, m.nr, m.nmu, m.nmus, m.nnu, c),
-                     grid4_lookup(m.orders, 3, 1, m.nr, m.nmu, m.nmus, m.nnu, c),
-                     grid4_lookup(m.orders, 3, 2, m.nr, m.nmu, m.nmus, m.nnu, c));
+    float fr, fm, fs, fn;
+    const int ir = grid_axis(c.xr, m.nr, fr), im = grid_axis(c.xmu, m.nmu, fm), is = grid_axis(c.xmus, m.nmus, fs),
+              in = grid_axis(c.xnu, m.nnu, fn);
+    glm::vec3 sum(0.0f);
+    for (int a = 0; a < 2; ++a)
+        for (int b = 0; b < 2; ++b)
+            for (int s = 0; s < 2; ++s)
+                for (int n = 0; n < 2; ++n) {
+                    const float w = (a ? fr : 1.0f - fr) * (b ? fm : 1.0f - fm) * (s ? fs : 1.0f - fs) *
+                                    (n ? fn : 1.0f - fn);
+                    const float* v = m.orders + 3 * grid4_index(m.nmu, m.nmus, m.nnu, ir + a, c.ground, im + b, is + s,
+                                                                in + n);
+                    sum += w * glm::vec3(v[0], v[1], v[2]);
+                }
+    return sum;
 }
 
 // Bilinear look-up in an RGB table over altitude (uniform, ground to top) and
