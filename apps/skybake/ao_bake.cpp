@@ -296,6 +296,8 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
             j["ranks"] = d.ranks;
             j["gathered_bytes"] = d.bytes_gathered;
             j["gather_seconds"] = d.gather_seconds;
+            j["distributed_seconds"] = d.trace_seconds;
+            j["points_per_rank"] = d.points_per_rank;
         }
         j["vertices_per_second"] = r.trace_seconds > 0 ? double(r.vertices) / r.trace_seconds : 0.0;
         if (texture) {
@@ -426,8 +428,10 @@ void run_batch(const AoOptions& o, const CLI::App& sub, bool job) {
         throw Error(fmt::format("{} lists no assets (one path a line; # starts a comment)", o.batch), "--batch");
     const std::filesystem::path dir(o.out_dir);
     std::error_code ec;
-    if (!std::filesystem::is_directory(dir, ec))
-        throw Error(fmt::format("output folder {} does not exist; create it first", o.out_dir), "--out-dir");
+    if (!std::filesystem::is_directory(dir, ec) && !std::filesystem::create_directory(dir, ec))
+        throw Error(fmt::format("cannot create the output folder {}: {}", o.out_dir,
+                                ec ? ec.message() : std::string("a file of that name is in the way")),
+                    "--out-dir");
     std::vector<std::filesystem::path> outputs;
     std::map<std::string, std::size_t> by_output;
     for (std::size_t i = 0; i < assets.size(); ++i) {

@@ -21,6 +21,7 @@
 #include <cstring>
 #include <deque>
 #include <exception>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -53,6 +54,7 @@ constexpr std::uint32_t kMinChunk = 256;
 JobRank g_rank;
 bool g_joined = false;
 DistributedStats g_stats;
+std::uint64_t g_queue = 0; // queues run so far (every rank runs the same sequence)
 
 // The rank an MPI launcher gave this process, read from the environment
 // (before or without MPI_Init); -1 when there is none.
@@ -74,14 +76,8 @@ using TaskWork = std::function<std::vector<char>(std::size_t task)>;
 using TaskCollect = std::function<void(std::size_t task, int rank, const char* data, std::size_t bytes)>;
 using TaskWeight = std::function<std::uint64_t(std::size_t task)>;
 
-// Runs every task here, in order (no job, or a job without MPI).
-void run_here(std::size_t count, const TaskWork& work, const TaskCollect& collect, const TaskWeight& weight,
-              Progress& progress) {
-    for (std::size_t t = 0; t < count; ++t) {
-        const std::vector<char> r = work(t);
-        collect(t, 0, r.data(), r.size());
-        progress.advance(weight(t));
-    }
+void nap() {
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
 }
 
 #if defined(SKYBAKE_HAS_MPI)
@@ -93,11 +89,6 @@ int result_tag(std::uint64_t queue) {
 }
 int assign_tag(std::uint64_t queue) {
     return 11 + 2 * int(queue % 16000);
-}
-std::uint64_t g_queue = 0; // queues run so far
-
-void nap() {
-    std::this_thread::sleep_for(std::chrono::microseconds(200));
 }
 
 void finalize_at_exit() {
@@ -121,94 +112,6 @@ void finalize_at_exit() {
     std::abort();
 }
 
-// Rank 0: hands out tasks to every rank and to a thread of its own, collects results.
-void serve(std::size_t count, const TaskWork& work, const TaskCollect& collect, const TaskWeight& weight,
-           Progress& progress, double& gather_seconds) {
-    std::atomic<std::size_t> next{0};
-    std::atomic<bool> stop{false}, local_finished{false};
-    std::mutex mutex;
-    std::deque<std::pair<std::size_t, std::vector<char>>> local_done;
-    std::exception_ptr local_error;
-    std::thread local([&] {
-        try {
-            use_cuda_device_on_this_thread();
-            while (!stop) {
-                const std::size_t t = next++;
-                if (t >= count)
-                    break;
-                std::vector<char> r = work(t);
-                const std::lock_guard<std::mutex> lock(mutex);
-                local_done.emplace_back(t, std::move(r));
-            }
-        } catch (...) {
-            const std::lock_guard<std::mutex> lock(mutex);
-            local_error = std::current_exception();
-        }
-        local_finished = true;
-    });
-    const int tag_result = result_tag(g_queue), tag_assign = assign_tag(g_queue);
-    int active = g_rank.size - 1; // ranks not yet told that the queue is empty
-    std::vector<char> buffer;
-    try {
-        while (active > 0 || !local_finished || !local_done.empty()) {
-            bool busy = false;
-            std::deque<std::pair<std::size_t, std::vector<char>>> done;
-            {
-                const std::lock_guard<std::mutex> lock(mutex);
-                if (local_error)
-                    std::rethrow_exception(local_error);
-                done.swap(local_done);
-            }
-            for (auto& [t, r] : done) {
-                collect(t, 0, r.data(), r.size());
-                progress.advance(weight(t));
-                busy = true;
-            }
-            int flag = 0;
-            MPI_Status st;
-            MPI_Iprobe(MPI_ANY_SOURCE, kTagError, MPI_COMM_WORLD, &flag, &st);
-            if (flag)
-                relay_error(st);
-            MPI_Iprobe(MPI_ANY_SOURCE, tag_result, MPI_COMM_WORLD, &flag, &st);
-            if (flag) {
-                busy = true;
-                const auto t0 = std::chrono::steady_clock::now();
-                int bytes = 0;
-                MPI_Get_count(&st, MPI_BYTE, &bytes);
-                buffer.resize(std::size_t(bytes));
-                MPI_Recv(buffer.data(), bytes, MPI_BYTE, st.MPI_SOURCE, tag_result, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-                std::int64_t task = -1;
-                std::memcpy(&task, buffer.data(), sizeof task);
-                if (task >= 0) {
-                    collect(std::size_t(task), st.MPI_SOURCE, buffer.data() + 8, buffer.size() - 8);
-                    progress.advance(weight(std::size_t(task)));
-                }
-                gather_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-                std::int64_t assign = -1;
-                if (!stop) {
-                    const std::size_t t = next++;
-                    if (t < count)
-                        assign = std::int64_t(t);
-                }
-                MPI_Send(&assign, 1, MPI_INT64_T, st.MPI_SOURCE, tag_assign, MPI_COMM_WORLD);
-                if (assign < 0)
-                    --active;
-            }
-            if (!busy) {
-                check_interrupted();
-                nap();
-            }
-        }
-    } catch (...) {
-        stop = true;
-        local.join();
-        throw;
-    }
-    local.join();
-    if (local_error)
-        std::rethrow_exception(local_error);
-}
-
 // Ranks other than 0: ask, work, return, until the queue is empty.
 void work_for_root(const TaskWork& work) {
     const int tag_result = result_tag(g_queue), tag_assign = assign_tag(g_queue);
@@ -227,8 +130,10 @@ void work_for_root(const TaskWork& work) {
             check_interrupted();
             nap();
         }
-        if (task < 0)
+        if (task < 0) {
+            ++g_queue;
             return;
+        }
         const std::vector<char> r = work(std::size_t(task));
         if (r.size() > std::size_t(0x7fffffff) - 8)
             throw Error(fmt::format("a chunk of {} bytes is too large for one message", r.size()), "mpi");
@@ -240,28 +145,159 @@ void work_for_root(const TaskWork& work) {
 
 #endif // SKYBAKE_HAS_MPI
 
-// Runs a queue over the job (or here, without one).
+// Rank 0's side of a queue (and the whole of it without a job): hands out
+// tasks to the other ranks and to a thread of its own, and collects their
+// results on the calling thread, the one that calls MPI, whenever it pumps.
+class Queue {
+public:
+    Queue(std::size_t count, TaskWork work, TaskCollect collect, TaskWeight weight, Progress* progress)
+        : count_(count), work_(std::move(work)), collect_(std::move(collect)), weight_(std::move(weight)),
+          progress_(progress), active_(g_joined ? g_rank.size - 1 : 0) {
+#if defined(SKYBAKE_HAS_MPI)
+        tag_result_ = result_tag(g_queue);
+        tag_assign_ = assign_tag(g_queue);
+#endif
+        local_ = std::thread([this] { run_local(); });
+    }
+    ~Queue() {
+        stop_ = true;
+        if (local_.joinable())
+            local_.join();
+    }
+    Queue(const Queue&) = delete;
+    Queue& operator=(const Queue&) = delete;
+
+    // Collects what has come in (the local thread's results, one message of
+    // another rank) and answers that rank. Returns whether anything came.
+    // Throws the local thread's error.
+    bool pump() {
+        bool busy = false;
+        std::deque<std::pair<std::size_t, std::vector<char>>> done;
+        {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            if (local_error_)
+                std::rethrow_exception(local_error_);
+            done.swap(local_done_);
+        }
+        for (auto& [t, r] : done) {
+            collect_(t, 0, r.data(), r.size());
+            if (progress_)
+                progress_->advance(weight_(t));
+            busy = true;
+        }
+#if defined(SKYBAKE_HAS_MPI)
+        if (g_joined) {
+            int flag = 0;
+            MPI_Status st;
+            MPI_Iprobe(MPI_ANY_SOURCE, kTagError, MPI_COMM_WORLD, &flag, &st);
+            if (flag)
+                relay_error(st);
+            MPI_Iprobe(MPI_ANY_SOURCE, tag_result_, MPI_COMM_WORLD, &flag, &st);
+            if (flag) {
+                busy = true;
+                const auto t0 = std::chrono::steady_clock::now();
+                int bytes = 0;
+                MPI_Get_count(&st, MPI_BYTE, &bytes);
+                buffer_.resize(std::size_t(bytes));
+                MPI_Recv(buffer_.data(), bytes, MPI_BYTE, st.MPI_SOURCE, tag_result_, MPI_COMM_WORLD,
+                         MPI_STATUS_IGNORE);
+                std::int64_t task = -1;
+                std::memcpy(&task, buffer_.data(), sizeof task);
+                if (task >= 0) {
+                    collect_(std::size_t(task), st.MPI_SOURCE, buffer_.data() + 8, buffer_.size() - 8);
+                    if (progress_)
+                        progress_->advance(weight_(std::size_t(task)));
+                }
+                gather_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+                std::int64_t assign = -1;
+                if (!stop_) {
+                    const std::size_t t = next_++;
+                    if (t < count_)
+                        assign = std::int64_t(t);
+                }
+                MPI_Send(&assign, 1, MPI_INT64_T, st.MPI_SOURCE, tag_assign_, MPI_COMM_WORLD);
+                if (assign < 0)
+                    --active_;
+            }
+        }
+#endif
+        return busy;
+    }
+    // Pumps until every task is in and every rank has been told that the
+    // queue is empty.
+    void finish() {
+        for (;;) {
+            bool idle_here;
+            {
+                const std::lock_guard<std::mutex> lock(mutex_);
+                idle_here = local_finished_ && local_done_.empty() && !local_error_;
+            }
+            if (idle_here && active_ == 0)
+                break;
+            if (!pump()) {
+                check_interrupted();
+                nap();
+            }
+        }
+        local_.join();
+        if (local_error_)
+            std::rethrow_exception(local_error_);
+        ++g_queue;
+    }
+
+    double gather_seconds = 0.0; // receiving and collecting other ranks' results
+
+private:
+    void run_local() {
+        try {
+            use_cuda_device_on_this_thread();
+            while (!stop_) {
+                const std::size_t t = next_++;
+                if (t >= count_)
+                    break;
+                std::vector<char> r = work_(t);
+                const std::lock_guard<std::mutex> lock(mutex_);
+                local_done_.emplace_back(t, std::move(r));
+            }
+        } catch (...) {
+            const std::lock_guard<std::mutex> lock(mutex_);
+            local_error_ = std::current_exception();
+        }
+        const std::lock_guard<std::mutex> lock(mutex_);
+        local_finished_ = true;
+    }
+
+    std::size_t count_;
+    TaskWork work_;
+    TaskCollect collect_;
+    TaskWeight weight_;
+    Progress* progress_;
+    int active_; // other ranks not yet told that the queue is empty
+    int tag_result_ = 0, tag_assign_ = 0;
+    std::atomic<std::size_t> next_{0};
+    std::atomic<bool> stop_{false};
+    std::mutex mutex_;
+    bool local_finished_ = false;
+    std::deque<std::pair<std::size_t, std::vector<char>>> local_done_;
+    std::exception_ptr local_error_;
+    std::vector<char> buffer_;
+    std::thread local_;
+};
+
+// Runs a queue over the job (or here, without one), to the end.
 void run_queue(std::size_t count, const TaskWork& work, const TaskCollect& collect, const TaskWeight& weight,
                const std::string& label, std::uint64_t total_weight, double& gather_seconds) {
-    if (!g_joined) {
-        Progress progress(label, total_weight);
-        run_here(count, work, collect, weight, progress);
-        progress.finish();
+#if defined(SKYBAKE_HAS_MPI)
+    if (g_joined && g_rank.rank != 0) {
+        work_for_root(work);
         return;
     }
-#if defined(SKYBAKE_HAS_MPI)
-    if (g_rank.rank == 0) {
-        Progress progress(label, total_weight);
-        serve(count, work, collect, weight, progress, gather_seconds);
-        progress.finish();
-    } else {
-        work_for_root(work);
-    }
-    ++g_queue;
-#else
-    (void)gather_seconds;
-    throw Error(kNoMpiMessage, "mpi");
 #endif
+    Progress progress(label, total_weight);
+    Queue queue(count, work, collect, weight, &progress);
+    queue.finish();
+    progress.finish();
+    gather_seconds += queue.gather_seconds;
 }
 
 // The tracer behind make_distributed_tracer().
@@ -277,13 +313,18 @@ public:
         words_per_point_ = rule.words_per_vertex;
         directions_ = std::max<std::size_t>(1, rule.points.size());
         local_limit_ = std::max<std::uint32_t>(1, local_->set_rule(rule));
-        return 0xffffffffu; // the driver's chunks only read the words back
+        // The driver's chunks read the words back as they arrive: as small as
+        // a CPU bake's, so that its reduction follows the tracing closely.
+        return std::uint32_t(std::max<std::uint64_t>(kMinChunk, kChunkRays / directions_));
     }
     bool prefers_large_chunks() const override { return true; }
 
+    // Starts the queue over the points' chunks. Rank 0 (or no job) returns at
+    // once: trace() then collects chunks while the driver reduces the ones
+    // before, so that the reduction overlaps the tracing of the rest. The
+    // other ranks trace their share here and return when the queue is empty.
     void trace_points(std::uint32_t n, const bake::ChunkBuilder& build) override {
         const int ranks = g_joined ? g_rank.size : 1;
-        const bool root = g_rank.rank == 0;
         const std::uint32_t w = words_per_point_;
         // Chunks: as the single-process driver sizes them for a CPU tracer
         // (rays per chunk) or a GPU tracer (its limit), but enough of them for
@@ -292,60 +333,109 @@ public:
         const std::uint64_t wanted = local_->prefers_large_chunks() ? local_limit_ : by_rays;
         const std::uint64_t spread = std::max<std::uint64_t>(kMinChunk, n / (std::uint64_t(ranks) * kChunksPerRank));
         const std::uint64_t by_bytes = std::max<std::uint64_t>(1, kChunkWordBytes / (4ull * std::max(w, 1u)));
-        const auto chunk = std::uint32_t(std::max<std::uint64_t>(
+        n_ = n;
+        chunk_ = std::uint32_t(std::max<std::uint64_t>(
             1, std::min({wanted, spread, by_bytes, std::uint64_t(local_limit_), std::uint64_t(std::max(n, 1u))})));
-        const std::size_t chunks = n == 0 ? 0 : (std::size_t(n) + chunk - 1) / chunk;
-        words_.assign(root ? std::size_t(n) * w : 0, 0u);
-
-        DistributedStats stats;
-        stats.ranks = ranks;
-        stats.chunks = chunks;
-        stats.points = n;
-        stats.points_per_rank.assign(std::size_t(ranks), 0);
-        std::atomic<int> traced_here{0};
-        const auto range = [&](std::size_t t) {
-            const std::uint32_t first = std::uint32_t(t) * chunk;
-            return std::pair<std::uint32_t, std::uint32_t>(first, std::min(chunk, n - first));
-        };
-        const TaskWork work = [&](std::size_t t) {
+        const std::size_t chunks = n == 0 ? 0 : (std::size_t(n) + chunk_ - 1) / chunk_;
+        build_ = build;
+        traced_here_ = 0;
+        stats_ = DistributedStats{};
+        stats_.ranks = ranks;
+        stats_.chunks = chunks;
+        stats_.points = n;
+        stats_.points_per_rank.assign(std::size_t(ranks), 0);
+        start_ = std::chrono::steady_clock::now();
+        const TaskWork work = [this](std::size_t t) { return trace_task(t); };
+#if defined(SKYBAKE_HAS_MPI)
+        if (g_joined && g_rank.rank != 0) {
+            words_.clear();
+            work_for_root(work);
+            finish_stats();
+            return;
+        }
+#endif
+        words_.assign(std::size_t(n) * w, 0u);
+        arrived_.assign(chunks, 0);
+        const TaskCollect collect = [this](std::size_t t, int rank, const char* data, std::size_t bytes) {
             const auto [first, count] = range(t);
-            thread_local bake::ChunkInputs inputs;
-            std::vector<char> bytes(std::size_t(count) * w * 4);
-            const TraceChunk tc =
-                build(first, count, inputs,
-                      std::span<std::uint32_t>(reinterpret_cast<std::uint32_t*>(bytes.data()), std::size_t(count) * w));
-            local_->trace(tc);
-            if (traced_here++ == 0)
-                test_fault_point("chunk");
-            return bytes;
-        };
-        const TaskCollect collect = [&](std::size_t t, int rank, const char* data, std::size_t bytes) {
-            const auto [first, count] = range(t);
-            if (bytes != std::size_t(count) * w * 4)
+            const std::size_t want = std::size_t(count) * words_per_point_ * 4;
+            if (bytes != want)
                 throw Error(fmt::format("rank {} returned {} bytes for a chunk of {} points ({} expected)", rank, bytes,
-                                        count, std::size_t(count) * w * 4),
+                                        count, want),
                             "mpi");
-            std::memcpy(words_.data() + std::size_t(first) * w, data, bytes);
+            std::memcpy(words_.data() + std::size_t(first) * words_per_point_, data, bytes);
             if (rank != 0)
-                stats.bytes_gathered += bytes;
-            stats.points_per_rank[std::size_t(rank)] += count;
+                stats_.bytes_gathered += bytes;
+            stats_.points_per_rank[std::size_t(rank)] += count;
+            arrived_[t] = 1;
         };
-        const TaskWeight weight = [&](std::size_t t) { return std::uint64_t(range(t).second); };
-        const auto t0 = std::chrono::steady_clock::now();
-        run_queue(chunks, work, collect, weight, "bake", n, stats.gather_seconds);
-        stats.trace_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        g_stats = stats;
+        queue_ = std::make_unique<Queue>(
+            chunks, work, collect, [](std::size_t) { return std::uint64_t(0); }, nullptr);
+        if (n == 0)
+            end_queue();
     }
 
+    // In order, as the driver asks: waits for the chunks that hold the
+    // points, then hands out their words (zeros on ranks other than 0).
     void trace(const TraceChunk& chunk) override {
         const std::size_t w = words_per_point_;
-        if (words_.empty()) { // not rank 0: no words here
+        if (!queue_ && words_.empty()) {
             std::fill(chunk.words.begin(), chunk.words.end(), 0u);
             return;
         }
+        if (queue_ && chunk.count > 0) {
+            const std::size_t lo = chunk.first / chunk_, hi = (std::size_t(chunk.first) + chunk.count - 1) / chunk_;
+            for (std::size_t t = lo; t <= hi; ++t)
+                while (!arrived_[t])
+                    if (!queue_->pump()) {
+                        check_interrupted();
+                        nap();
+                    }
+        }
         std::copy_n(words_.begin() + std::ptrdiff_t(std::size_t(chunk.first) * w), std::size_t(chunk.count) * w,
                     chunk.words.begin());
+        if (queue_ && std::size_t(chunk.first) + chunk.count >= n_)
+            end_queue();
     }
+
+private:
+    std::pair<std::uint32_t, std::uint32_t> range(std::size_t t) const {
+        const std::uint32_t first = std::uint32_t(t) * chunk_;
+        return {first, std::min(chunk_, n_ - first)};
+    }
+
+    std::vector<char> trace_task(std::size_t t) {
+        const auto [first, count] = range(t);
+        thread_local bake::ChunkInputs inputs;
+        std::vector<char> bytes(std::size_t(count) * words_per_point_ * 4);
+        const TraceChunk tc = build_(first, count, inputs,
+                                     std::span<std::uint32_t>(reinterpret_cast<std::uint32_t*>(bytes.data()),
+                                                              std::size_t(count) * words_per_point_));
+        local_->trace(tc);
+        if (traced_here_++ == 0)
+            test_fault_point("chunk");
+        return bytes;
+    }
+
+    void end_queue() {
+        queue_->finish();
+        stats_.gather_seconds = queue_->gather_seconds;
+        queue_.reset();
+        finish_stats();
+    }
+
+    void finish_stats() {
+        stats_.trace_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+        g_stats = stats_;
+    }
+
+    std::uint32_t n_ = 0, chunk_ = 1;
+    bake::ChunkBuilder build_;
+    std::atomic<int> traced_here_{0};
+    DistributedStats stats_;
+    std::chrono::steady_clock::time_point start_;
+    std::vector<std::uint8_t> arrived_;
+    std::unique_ptr<Queue> queue_;
 
 private:
     std::unique_ptr<VisibilityTracer> local_;
