@@ -18,6 +18,8 @@ PACKAGES=(
   libglm-dev libeigen3-dev
   # CLI, formatting, JSON
   libcli11-dev libfmt-dev nlohmann-json3-dev
+  # distributed bakes (mpirun)
+  libopenmpi-dev openmpi-bin
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev glslang-tools
   # OpenGL (headless EGL and windowed GLFW)

@@ -24,9 +24,10 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The shared inputs, made once: a small mesh, a sky CSV and a tiny weights file.
+// The shared inputs, made once: a small mesh, a sky CSV, a tiny weights file
+// and a batch list naming the mesh.
 struct Inputs {
-    std::string dir, mesh, csv, model;
+    std::string dir, mesh, csv, model, list;
 };
 
 const Inputs& inputs() {
@@ -37,6 +38,8 @@ const Inputs& inputs() {
         EXPECT_EQ(run_cli({"mesh", "generate", "--kind", "wall", "--triangles", "200", "-o", i.mesh}).exit_code, 0);
         i.csv = i.dir + "/samples.csv";
         std::ofstream(i.csv) << "cos_view_zenith,cos_view_sun,cos_sun_zenith,density\n1,1,1,1\n";
+        i.list = i.dir + "/assets.txt";
+        std::ofstream(i.list) << "# the mesh\n" << i.mesh << "\n";
         i.model = i.dir + "/tiny.json";
         const CliResult t = run_cli({"sky", "train", "--samples", "200", "--heldout", "50", "--epochs", "1",
                                      "--lm-iterations", "0", "-q", "-o", i.model});
@@ -46,7 +49,7 @@ const Inputs& inputs() {
     return in;
 }
 
-// {in}, {csv}, {model} and {out} in a command are replaced by the inputs and
+// {in}, {csv}, {model}, {list} and {out} in a command are replaced by the inputs and
 // by the case's output folder.
 std::vector<std::string> expand(const std::vector<std::string>& cmd, const std::string& out) {
     std::vector<std::string> r;
@@ -54,6 +57,7 @@ std::vector<std::string> expand(const std::vector<std::string>& cmd, const std::
         for (const auto& [key, value] : {std::pair<std::string, std::string>{"{in}", inputs().mesh},
                                          {"{csv}", inputs().csv},
                                          {"{model}", inputs().model},
+                                         {"{list}", inputs().list},
                                          {"{out}", out}}) {
             const auto p = a.find(key);
             if (p != std::string::npos)
@@ -250,6 +254,7 @@ const OutputFlag kOutputFlags[] = {
     {{"ao", "{in}", "--rule", "lebedev:6"}, "-o", "a.glb"},
     {{"ao", "{in}", "--rule", "lebedev:6", "-o", "{out}/a.glb"}, "--preview", "p.png"},
     {{"ao", "{in}", "--rule", "lebedev:6", "-o", "{out}/a.glb"}, "--bits", "b.bin"},
+    {{"ao", "--batch", "{list}", "--rule", "lebedev:6"}, "--out-dir", "baked"},
     {{"sky", "eval", "--input", "{csv}"}, "--output", "o.csv"},
     {{"sky", "render", "--altitude-km", "0", "--sun-elevation-deg", "10", "--size", "8x8"}, "-o", "r.png"},
     {{"sky", "train", "--samples", "100", "--epochs", "1", "--lm-iterations", "0"}, "-o", "w.json"},

@@ -37,7 +37,7 @@ def closure(name, seen=None):
 allowed = {m: closure(m) | {m} for m in direct}
 # The public header each module owns (include/skybake/NAME.h).
 owner = {"bake.h": "bake", "visibility.h": "visibility", "sky.h": "sky", "neural.h": "neural",
-         "sphere.h": "sphere", "mesh.h": "io", "image.h": "io", "gltf_asset.h": "io", "sh.h": "sphere", "texture_bake.h": "bake",
+         "sphere.h": "sphere", "mesh.h": "io", "image.h": "io", "gltf_asset.h": "io", "sh.h": "sphere", "texture_bake.h": "bake", "distributed.h": "distributed",
          "sky_source.h": "neural", "planet.h": "planet", "render.h": "render", "prt.h": "prt",
          "viewer.h": "render"}
 include = re.compile(r'#\s*include\s+"(\w+)/([^"]+)"')

@@ -2,20 +2,28 @@
 //            [--max-distance D] [--offset E]
 //            [--back-faces occlude|ignore] [--normalize] [--bits FILE] [--preview FILE.png]
 //            [--preview-size WxH] [--texture N [--uv K] [--texture-out FILE.png|.exr] [--dilate N]] [--json]
+// skybake ao --batch LIST --out-dir DIR [the same bake flags]
+// Under mpirun (or with --mpi) the bake is spread over the ranks (job.h).
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <map>
+#include <sstream>
 #include <limits>
 #include <optional>
 
 #include "cli.h"
 #include "commands.h"
 #include "flags.h"
+#include "job.h"
 #include "skybake/files.h"
 #include "skybake/bake.h"
 #include "skybake/core.h"
 #include "skybake/gltf_asset.h"
+#include "skybake/interrupt.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 #include "skybake/texture_bake.h"
@@ -47,6 +55,8 @@ struct AoOptions {
     int uv = 0;
     std::string texture_out;
     int dilate = 8;
+    bool mpi = false;
+    std::string batch, out_dir;
 };
 
 // The texture file beside the output: OUT.glb -> OUT_ao.png.
@@ -107,7 +117,8 @@ std::string backend_name(const AoOptions& o) {
     return o.backend;
 }
 
-void run(const AoOptions& o, const CLI::App& sub) {
+// One bake: INPUT to OUTPUT. `job`: spread over the ranks of an MPI job.
+void run(const AoOptions& o, const CLI::App& sub, bool job) {
     // Everything that can be checked without the mesh is checked first, so a
     // typo fails at once and no output file is started.
     const SphereRule rule = parse_flag("--rule", [&] { return parse_rule(o.rule); });
@@ -161,7 +172,8 @@ void run(const AoOptions& o, const CLI::App& sub) {
             throw UsageError("a texture bake is wired into a glTF material; write the mesh as .glb or .gltf",
                              "--output");
     }
-    const auto tracer = make_visibility_tracer(backend_id, method, o.resolution); // no GPU or GL: exit 1
+    // no GPU or GL: exit 1; in a job, each rank traces with its own
+    const auto tracer = job_tracer(make_visibility_tracer(backend_id, method, o.resolution), job);
     const std::uint32_t resolution = o.resolution                  ? o.resolution
                                      : method == TraceMethod::Cube ? kRasterCubeResolution
                                                                    : kRasterDirectionalResolution;
@@ -184,6 +196,7 @@ void run(const AoOptions& o, const CLI::App& sub) {
         throw UsageError("a .gltf output keeps a glTF 2.0 input's document; write other inputs as .glb", "--output");
     Mesh plain = asset ? Mesh() : load_mesh(o.input);
     Mesh& mesh = asset ? asset->mesh() : plain;
+    test_fault_point("load");
     // The texture bake first: its checks of the UV layout and the size come
     // before any long work.
     std::optional<AoTexture> texture;
@@ -208,6 +221,9 @@ void run(const AoOptions& o, const CLI::App& sub) {
         else
             wire_occlusion(mesh, std::filesystem::absolute(texture_out).string(), o.uv);
     }
+
+    if (job && !job_root())
+        return; // in a job, rank 0 alone has the results, and writes them
 
     // Every output is staged, then all are committed together: a failure in
     // any one of them leaves none written.
@@ -275,6 +291,14 @@ void run(const AoOptions& o, const CLI::App& sub) {
                             {"preview", o.preview.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.preview)},
                             {"bits", o.bits.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.bits)},
                             {"threads", thread_count()}};
+        if (job) {
+            const DistributedStats d = last_distributed_stats();
+            j["ranks"] = d.ranks;
+            j["gathered_bytes"] = d.bytes_gathered;
+            j["gather_seconds"] = d.gather_seconds;
+            j["distributed_seconds"] = d.trace_seconds;
+            j["points_per_rank"] = d.points_per_rank;
+        }
         j["vertices_per_second"] = r.trace_seconds > 0 ? double(r.vertices) / r.trace_seconds : 0.0;
         if (texture) {
             const double sec = texture->trace_seconds;
@@ -321,15 +345,162 @@ void run(const AoOptions& o, const CLI::App& sub) {
          texture ? ", " + texture_out : "");
 }
 
+// [batch] ------------------------------------------------------------------------------
+//
+// `--batch LIST --out-dir DIR`: every asset of LIST (one path a line, relative
+// to LIST's folder; blank lines and lines starting with # skipped) is baked to
+// DIR/<stem>.glb with the same flags, whole meshes handed to the ranks of a
+// job from a queue on rank 0. Beside each output, DIR/<stem>.glb.bake.json
+// records the input (absolute path, size, modification time) and the flags
+// that shape the result; a rerun skips an asset whose output and record are
+// both there, the record matches, and the output is not older than the input.
+
+// The flags that shape a bake's output, as one text (recorded, and compared on a rerun).
+std::string batch_flags(const AoOptions& o) {
+    return fmt::format("skybake {}; rule {}; device {}; backend {}; method {}; resolution {}; max-distance {}; "
+                       "offset {}; back-faces {}; normalize {}; texture {}; uv {}; dilate {}",
+                       version(), o.rule, o.device, o.backend.empty() ? "default" : o.backend,
+                       o.method.empty() ? "default" : o.method, o.resolution, o.max_distance, o.offset, o.back_faces,
+                       o.normalize, o.texture, o.uv, o.dilate);
+}
+
+std::int64_t mtime_ns(const std::filesystem::path& p) {
+    return std::chrono::duration_cast<std::chrono::nanoseconds>(std::filesystem::last_write_time(p).time_since_epoch())
+        .count();
+}
+
+nlohmann::json batch_record(const std::filesystem::path& input, const AoOptions& o) {
+    return {{"input", std::filesystem::absolute(input).lexically_normal().string()},
+            {"input_bytes", std::filesystem::file_size(input)},
+            {"input_mtime_ns", mtime_ns(input)},
+            {"flags", batch_flags(o)}};
+}
+
+std::filesystem::path record_path(const std::filesystem::path& output) {
+    return output.string() + ".bake.json";
+}
+
+// Whether `output` is complete and current for `input` baked with `o`.
+bool batch_current(const std::filesystem::path& input, const std::filesystem::path& output, const AoOptions& o) {
+    std::error_code ec;
+    const std::filesystem::path rec = record_path(output);
+    if (!std::filesystem::is_regular_file(output, ec) || !std::filesystem::is_regular_file(rec, ec) ||
+        !std::filesystem::is_regular_file(input, ec))
+        return false;
+    if (o.texture != 0 && !std::filesystem::is_regular_file(default_texture_path(output.string()), ec))
+        return false;
+    try {
+        const nlohmann::json want = batch_record(input, o);
+        const nlohmann::json have = nlohmann::json::parse(read_file(rec, 1 << 20));
+        return have == want && mtime_ns(output) >= want["input_mtime_ns"].get<std::int64_t>();
+    } catch (const std::exception&) {
+        return false; // unreadable record: bake again
+    }
+}
+
+void run_batch(const AoOptions& o, const CLI::App& sub, bool job) {
+    for (const char* f : {"input", "--output", "--bits", "--preview", "--texture-out", "--json"})
+        refuse_if_given(sub, f, "with --batch (each asset's outputs are named after it in --out-dir)");
+    if (o.out_dir.empty())
+        throw UsageError("--batch needs --out-dir DIR for the outputs", "--out-dir");
+    // The flags are checked once, before any asset.
+    parse_flag("--rule", [&] { return parse_rule(o.rule); });
+    backend_name(o);
+    parse_flag("--back-faces", [&] { return parse_back_faces(o.back_faces); });
+    if (!o.method.empty())
+        parse_flag("--method", [&] { return parse_trace_method(o.method); });
+
+    const std::filesystem::path list(o.batch);
+    std::vector<std::filesystem::path> assets;
+    {
+        std::istringstream in(read_file(list, std::uint64_t(64) << 20));
+        std::string line;
+        while (std::getline(in, line)) {
+            const auto b = line.find_first_not_of(" \t\r");
+            if (b == std::string::npos || line[b] == '#')
+                continue;
+            const auto e = line.find_last_not_of(" \t\r");
+            const std::filesystem::path p(line.substr(b, e - b + 1));
+            assets.push_back(p.is_absolute() ? p : list.parent_path() / p);
+        }
+    }
+    if (assets.empty())
+        throw Error(fmt::format("{} lists no assets (one path a line; # starts a comment)", o.batch), "--batch");
+    const std::filesystem::path dir(o.out_dir);
+    std::error_code ec;
+    if (!std::filesystem::is_directory(dir, ec) && !std::filesystem::create_directory(dir, ec))
+        throw Error(fmt::format("cannot create the output folder {}: {}", o.out_dir,
+                                ec ? ec.message() : std::string("a file of that name is in the way")),
+                    "--out-dir");
+    std::vector<std::filesystem::path> outputs;
+    std::map<std::string, std::size_t> by_output;
+    for (std::size_t i = 0; i < assets.size(); ++i) {
+        outputs.push_back(dir / (assets[i].stem().string() + ".glb"));
+        const auto [it, fresh] = by_output.emplace(outputs.back().string(), i);
+        if (!fresh)
+            throw Error(fmt::format("{} and {} would both be written to {}; rename one", assets[it->second].string(),
+                                    assets[i].string(), outputs.back().string()),
+                        "--batch");
+    }
+
+    // Each task bakes one whole asset on one rank; its failure is reported,
+    // not fatal. Results: "" baked, "skip" current, else the error line.
+    const auto task = [&](std::size_t i) -> std::string {
+        if (batch_current(assets[i], outputs[i], o))
+            return "skip";
+        try {
+            AoOptions one = o;
+            one.input = assets[i].string();
+            one.output = outputs[i].string();
+            one.batch.clear();
+            run(one, sub, false);
+            const std::string record = batch_record(assets[i], o).dump(2) + "\n";
+            write_stream_atomic(record_path(outputs[i]), [&](std::ostream& out) { out << record; });
+            return {};
+        } catch (const Interrupted&) {
+            throw;
+        } catch (const UsageError& e) {
+            return format_error_line(e.message(), e.where());
+        } catch (const Error& e) {
+            return format_error_line(e.message(), flag_for_field(e.where()));
+        } catch (const std::exception& e) {
+            return fmt::format("internal error: {}", e.what());
+        }
+    };
+    const std::vector<std::string> results = run_task_queue(assets.size(), task, "batch");
+    std::int64_t failed = 0;
+    if (job_root()) {
+        std::size_t baked = 0, skipped = 0;
+        for (const std::string& r : results) {
+            if (r.empty())
+                ++baked;
+            else if (r == "skip")
+                ++skipped;
+            else
+                ++failed;
+        }
+        std::fprintf(stderr, "skybake: batch: %zu assets: %zu baked, %zu current (skipped), %lld failed\n",
+                     assets.size(), baked, skipped, static_cast<long long>(failed));
+        for (std::size_t i = 0; i < results.size(); ++i)
+            if (!results[i].empty() && results[i] != "skip")
+                std::fprintf(stderr, "skybake: failed: %s: %s\n", assets[i].string().c_str(), results[i].c_str());
+    }
+    if (job)
+        failed = broadcast_from_root(failed);
+    if (failed > 0)
+        throw JobError(fmt::format("{} of {} assets failed (listed above); the others are written", failed,
+                                   assets.size()),
+                       "--batch");
+}
+
 } // namespace
 
 void add_ao_bake(CLI::App& group) {
     auto o = std::make_shared<AoOptions>();
     CLI::App* sub = &group;
-    sub->add_option("input", o->input, "Input mesh (any format 'mesh info' reads)")->required();
+    sub->add_option("input", o->input, "Input mesh (any format 'mesh info' reads); not with --batch");
     sub->add_option("-o,--output", o->output, "Output mesh with AO, shading and bent normals (.glb, .gltf or .ply); a glTF 2.0 input keeps its "
-                    "whole document (nodes, materials, UVs, animations...)")
-        ->required();
+                    "whole document (nodes, materials, UVs, animations...)");
     sub->add_option("--rule", o->rule,
                     "Sphere rule, e.g. lebedev:5810, design:t21, fibonacci:1000, mc:4096; add +rotate for a random "
                     "rotation per vertex (see 'sphere list')")
@@ -380,7 +551,24 @@ void add_ao_bake(CLI::App& group) {
         ->check(integer_in(0, 256, "texels"))
         ->capture_default_str();
     add_json_flag(*sub, o->json);
-    sub->callback([o, sub] { run(*o, *sub); });
+    sub->add_flag("--mpi", o->mpi,
+                  "Run as one rank of an MPI job even when no launcher's variables say so (under mpirun or srun "
+                  "it is automatic); fails in a build without MPI");
+    sub->add_option("--batch", o->batch,
+                    "Bake every asset listed in this file (one path a line, relative to the file; # comments) to "
+                    "--out-dir, skipping outputs that are current; under mpirun whole assets go to the ranks");
+    sub->add_option("--out-dir", o->out_dir, "With --batch: the folder of the outputs, DIR/<stem>.glb");
+    sub->callback([o, sub] {
+        const bool job = start_job(o->mpi);
+        if (!o->batch.empty())
+            return run_batch(*o, *sub, job);
+        refuse_if_given(*sub, "--out-dir", "without --batch");
+        if (o->input.empty())
+            throw UsageError("the input mesh is missing: skybake ao INPUT -o OUTPUT (or --batch LIST)", "input");
+        if (o->output.empty())
+            throw UsageError("--output is required: the baked mesh (.glb, .gltf or .ply)", "--output");
+        run(*o, *sub, job);
+    });
 }
 
 SKYBAKE_CLI_GROUP_COMMAND("ao", add_ao_bake)

@@ -13,6 +13,7 @@
 #include "commands.h"
 #include "flags.h"
 #include "skybake/core.h"
+#include "skybake/distributed.h"
 #include "skybake/error.h"
 #include "skybake/interrupt.h"
 
@@ -28,7 +29,9 @@ std::string version_line() {
     return fmt::format("skybake {} ({})", skybake::version(), cuda);
 }
 
-void print_error(const std::string& line) { std::fprintf(stderr, "skybake: error: %s\n", line.c_str()); }
+// Prints the one error line and returns the exit code; in an MPI job, ends
+// every rank (skybake/distributed.h).
+int fail(const std::string& line, int code) { return skybake::finish_with_error(line, code); }
 
 // The command chain as far as it is known ("skybake sky"), for the usage hint.
 std::string command_path(const CLI::App* app) {
@@ -102,24 +105,21 @@ int main(int argc, char** argv) {
             if (!unknown.empty())
                 what = unknown;
         }
-        print_error(skybake::format_error_line(what, "command line; see --help"));
-        return 2;
+        return fail(skybake::format_error_line(what, "command line; see --help"), 2);
     } catch (const skybake::cli::UsageError& e) {
         const std::string where = e.where().empty() ? "command line" : e.where();
-        print_error(skybake::format_error_line(e.message(), where + "; see --help"));
-        return 2;
+        return fail(skybake::format_error_line(e.message(), where + "; see --help"), 2);
+    } catch (const skybake::JobError& e) {
+        return skybake::finish_with_job_error(
+            skybake::format_error_line(e.message(), skybake::cli::flag_for_field(e.where())), 1);
     } catch (const skybake::Interrupted& e) {
-        print_error(e.what());
-        return 128 + e.signal();
+        return fail(e.what(), 128 + e.signal());
     } catch (const skybake::Error& e) {
-        print_error(skybake::format_error_line(e.message(), skybake::cli::flag_for_field(e.where())));
-        return 1;
+        return fail(skybake::format_error_line(e.message(), skybake::cli::flag_for_field(e.where())), 1);
     } catch (const std::bad_alloc&) {
-        print_error("out of memory");
-        return 1;
+        return fail("out of memory", 1);
     } catch (const std::exception& e) {
-        print_error(skybake::format_error_line(fmt::format("internal error: {}", e.what()), ""));
-        return 1;
+        return fail(skybake::format_error_line(fmt::format("internal error: {}", e.what()), ""), 1);
     }
     return 0;
 }

@@ -1,12 +1,14 @@
 // skybake prt bake INPUT -o OUTPUT.glb|.ply [--order L] [--kind K] [--bounces N] [--rule R] [--backend B]
 //                  [--device D] [--albedo A] [--model prt|shading-coefficient] [--max-distance D] [--json]
 // Per-vertex diffuse SH transfer (skybake/prt.h), with a JSON sidecar.
+// Under mpirun (or with --mpi) the visibility is spread over the ranks (job.h).
 #include <limits>
 #include <sstream>
 
 #include "cli.h"
 #include "commands.h"
 #include "flags.h"
+#include "job.h"
 #include "skybake/files.h"
 #include "skybake/mesh.h"
 #include "skybake/prt.h"
@@ -19,7 +21,7 @@ struct BakeOpts {
     std::string input, output, rule = "lebedev:590", kind = "shadowed", model = "prt", albedo, backend, device = "cpu";
     int order = 3, bounces = 0;
     double max_distance = std::numeric_limits<double>::infinity();
-    bool json = false;
+    bool json = false, mpi = false;
 };
 
 // "0.8" or "0.8,0.6,0.4": a linear RGB reflectance in [0, 1].
@@ -50,6 +52,7 @@ glm::vec3 parse_albedo(const std::string& text) {
 }
 
 void run(const BakeOpts& o, const CLI::App& sub) {
+    const bool job = start_job(o.mpi); // first: in a job, every error is reported once
     const SphereRule rule = parse_flag("--rule", [&] { return parse_rule(o.rule); });
     if (rule.kind == RuleKind::Phong)
         throw UsageError(fmt::format("'{}' integrates against a Phong lobe, not over the sphere; use a lebedev, "
@@ -80,12 +83,20 @@ void run(const BakeOpts& o, const CLI::App& sub) {
     const bool constant_albedo = !o.albedo.empty();
     const glm::vec3 albedo_value = constant_albedo ? parse_albedo(o.albedo) : glm::vec3(0.8f);
     check_output_path(o.output, {".glb", ".ply"}, "--output");
-    const auto tracer = make_visibility_tracer(backend, default_trace_method(backend));
+    const auto tracer = job_tracer(make_visibility_tracer(backend, default_trace_method(backend)), job);
     std::unique_ptr<RayQueries> queries;
     if (t.kind == TransferKind::Interreflected)
         queries = make_ray_queries(backend);
+    if (job && !job_root() && t.kind == TransferKind::Interreflected) {
+        // The bounces run on rank 0, over the gathered words; the other ranks
+        // only trace visibility, which the shadowed bake shares.
+        t.kind = TransferKind::Shadowed;
+        t.bounces = 0;
+        queries.reset();
+    }
 
     Mesh mesh = load_mesh(o.input);
+    test_fault_point("load");
     const std::vector<glm::vec3> albedo =
         constant_albedo ? std::vector<glm::vec3>(mesh.vertex_count(), albedo_value) : mesh_albedo(mesh, albedo_value);
     const std::string albedo_source =
@@ -96,6 +107,8 @@ void run(const BakeOpts& o, const CLI::App& sub) {
     b.method = tracer->method();
     Transfer transfer;
     const TransferReport r = bake_transfer(mesh, rule, *tracer, b, t, albedo, queries.get(), transfer);
+    if (job && !job_root())
+        return; // rank 0 alone has the results, and writes them
     set_transfer_attributes(mesh, transfer, albedo);
 
     OutputSet files;
@@ -165,6 +178,9 @@ void add_prt_bake(CLI::App& group) {
         ->capture_default_str();
     sub->add_option("--max-distance", o->max_distance, "Ignore occluders further than this, in mesh units")
         ->check(real_in(0.0, 1e30, "mesh units", End::Open));
+    sub->add_flag("--mpi", o->mpi,
+                  "Run as one rank of an MPI job even when no launcher's variables say so (under mpirun or srun "
+                  "it is automatic); fails in a build without MPI");
     add_json_flag(*sub, o->json);
     sub->callback([o, sub] { run(*o, *sub); });
 }

@@ -19,8 +19,16 @@ int cuda_device_count();
 // cudaErrorInsufficientDriver for a missing or old driver,
 // cudaErrorSystemDriverMismatch, ...). Empty when a device is usable.
 std::string cuda_device_problem();
-// Name of CUDA device 0, or an empty string.
+// Name of the selected CUDA device (cuda_device_index()), or an empty string.
 std::string cuda_device_name();
+// The CUDA device that the GPU backends use: 0 unless set, e.g. to a rank's
+// local index among the processes on its node (skybake/distributed.h).
+// Taken modulo cuda_device_count() when used.
+void set_cuda_device_index(int index);
+int cuda_device_index();
+// Makes the selected device current on the calling thread (CUDA keeps one per
+// host thread); does nothing in a build without CUDA or without a device.
+void use_cuda_device_on_this_thread();
 // Throws skybake::Error, naming `where` (e.g. "--device cuda"), when this
 // build has no CUDA support or no CUDA device is present.
 void require_cuda_device(const std::string& where);

@@ -117,30 +117,44 @@ VisibilityBakeStats bake_points(const Mesh& mesh, std::uint32_t n, float ray_off
     const std::uint32_t chunk =
         std::max<std::uint32_t>(1, std::min({wanted, tracer_limit, memory_limit, std::max(n, 1u)}));
 
-    std::vector<glm::vec3> origins(chunk), chunk_normals(chunk), offsets(chunk);
-    std::vector<glm::mat3> rotations(rotate ? chunk : 0);
-    std::vector<std::uint32_t> chunk_words(host_words ? std::size_t(chunk) * words : 0);
-    Progress progress("bake", n);
-    for (std::uint32_t first = 0; first < n; first += chunk, ++stats.chunks) {
-        const std::uint32_t count = std::min(chunk, n - first);
+    const bake::ChunkBuilder build = [&](std::uint32_t first, std::uint32_t count, bake::ChunkInputs& in,
+                                         std::span<std::uint32_t> out_words) {
+        in.origins.resize(std::max<std::size_t>(in.origins.size(), count));
+        in.normals.resize(std::max<std::size_t>(in.normals.size(), count));
+        in.offsets.resize(std::max<std::size_t>(in.offsets.size(), count));
+        if (rotate)
+            in.rotations.resize(std::max<std::size_t>(in.rotations.size(), count));
         parallel_for(count, 1024, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) {
                 const std::size_t v = first + i;
-                frame(v, origins[i], chunk_normals[i], offsets[i]);
+                frame(v, in.origins[i], in.normals[i], in.offsets[i]);
                 if (rotate)
-                    rotations[i] = visit.rotation(std::uint32_t(v));
+                    in.rotations[i] = visit.rotation(std::uint32_t(v));
             }
         });
         TraceChunk tc;
         tc.first = first;
         tc.count = count;
-        tc.origins = std::span<const glm::vec3>(origins.data(), count);
-        tc.normals = std::span<const glm::vec3>(chunk_normals.data(), count);
-        tc.offsets = std::span<const glm::vec3>(offsets.data(), count);
+        tc.origins = std::span<const glm::vec3>(in.origins.data(), count);
+        tc.normals = std::span<const glm::vec3>(in.normals.data(), count);
+        tc.offsets = std::span<const glm::vec3>(in.offsets.data(), count);
         if (rotate)
-            tc.rotations = std::span<const glm::mat3>(rotations.data(), count);
-        if (host_words)
-            tc.words = std::span<std::uint32_t>(chunk_words.data(), std::size_t(count) * words);
+            tc.rotations = std::span<const glm::mat3>(in.rotations.data(), count);
+        tc.words = out_words;
+        return tc;
+    };
+    if (auto* whole = dynamic_cast<bake::WholeBakeTracer*>(&tracer))
+        whole->trace_points(n, build);
+
+    bake::ChunkInputs inputs;
+    std::vector<std::uint32_t> chunk_words(host_words ? std::size_t(chunk) * words : 0);
+    Progress progress("bake", n);
+    for (std::uint32_t first = 0; first < n; first += chunk, ++stats.chunks) {
+        const std::uint32_t count = std::min(chunk, n - first);
+        const TraceChunk tc =
+            build(first, count, inputs,
+                  host_words ? std::span<std::uint32_t>(chunk_words.data(), std::size_t(count) * words)
+                             : std::span<std::uint32_t>());
         tracer.trace(tc);
 
         VisibilityChunk vc;

@@ -20,7 +20,18 @@ bool build_has_cuda() {
 #endif
 }
 
+namespace {
+int selected_cuda_device = 0;
+} // namespace
+
+void set_cuda_device_index(int index) { selected_cuda_device = index < 0 ? 0 : index; }
+int cuda_device_index() {
+    const int n = cuda_device_count();
+    return n > 0 ? selected_cuda_device % n : 0;
+}
+
 #if !defined(SKYBAKE_HAS_CUDA)
+void use_cuda_device_on_this_thread() {}
 int cuda_device_count() { return 0; }
 std::string cuda_device_name() { return {}; }
 std::string cuda_device_problem() { return "this build has no CUDA support"; }

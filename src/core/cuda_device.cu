@@ -35,11 +35,16 @@ std::string cuda_device_problem() {
     return std::string(cudaGetErrorName(e)) + " (error " + std::to_string(int(e)) + "): " + cudaGetErrorString(e);
 }
 
+void use_cuda_device_on_this_thread() {
+    if (cuda_device_count() > 0 && cudaSetDevice(cuda_device_index()) != cudaSuccess)
+        cudaGetLastError(); // the backends report the error when they use the device
+}
+
 std::string cuda_device_name() {
     if (cuda_device_count() == 0)
         return {};
     cudaDeviceProp prop{};
-    if (cudaGetDeviceProperties(&prop, 0) != cudaSuccess)
+    if (cudaGetDeviceProperties(&prop, cuda_device_index()) != cudaSuccess)
         return {};
     return prop.name;
 }

@@ -197,7 +197,7 @@ CudaBackend::CudaBackend(TraceMethod method) : impl_(std::make_unique<Impl>()) {
     impl_->method = method;
     if (cuda_device_count() == 0)
         throw Error("no usable CUDA device (" + cuda_device_problem() + "); bake on the CPU instead", "device");
-    SKYBAKE_CUDA_CHECK(cudaSetDevice(0));
+    SKYBAKE_CUDA_CHECK(cudaSetDevice(cuda_device_index()));
     impl_->device = cuda_device_name();
 }
 
