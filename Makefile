@@ -43,7 +43,7 @@ test-gpu: build
 # Leaks inside third-party libraries (tools/fuzz/lsan.supp) are suppressed; skybake's are not.
 test-sanitize: deps
 	cmake -S . -B $(BUILD_ASAN) $(GENERATOR) -DCMAKE_BUILD_TYPE=Debug -DSKYBAKE_SANITIZE=ON \
-	  -DSKYBAKE_WITH_CUDA=OFF -DSKYBAKE_BUILD_BENCH=OFF $(CMAKE_FLAGS)
+	  -DSKYBAKE_WITH_CUDA=OFF -DSKYBAKE_WITH_MPI=OFF -DSKYBAKE_BUILD_BENCH=OFF $(CMAKE_FLAGS)
 	cmake --build $(BUILD_ASAN) -j $(JOBS) --target skybake_io_test_targets
 	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 LSAN_OPTIONS=suppressions=$(CURDIR)/tools/fuzz/lsan.supp \
 	  ctest --test-dir $(BUILD_ASAN) --output-on-failure -j $(JOBS) -L io
