@@ -5,6 +5,7 @@
 #   tools/fuzz/run.sh [TARGET...]          (default: every target)
 #   FUZZ_SECONDS=120 make fuzz             (seconds per target; default 120)
 #   FUZZ_JOBS=2                            (targets fuzzed at once; default: cores)
+#   FUZZ_TIMEOUT=20                        (seconds one input may take; raise it on a loaded machine)
 # Per target: tools/fuzz/corpus/NAME is the kept corpus (seeds, every past
 # crash, merged coverage), corpus-run/NAME the working set, crashes land in
 # crashes/NAME/. The last lines are a table: executions, coverage, crashes.
@@ -13,6 +14,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
 secs=${FUZZ_SECONDS:-120}
 jobs=${FUZZ_JOBS:-$(nproc)}
+timeout=${FUZZ_TIMEOUT:-20}
 build=$root/build-fuzz
 source_targets() { sed -n 's/^set(SKYBAKE_FUZZ_TARGETS \(.*\))$/\1/p' "$here/targets.cmake"; }
 targets=("$@")
@@ -43,7 +45,7 @@ run_one() {
   [ -f "$here/$t.dict" ] && dict=(-dict="$here/$t.dict")
   ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 LSAN_OPTIONS=suppressions=$here/lsan.supp \
     UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
-    "$build/fuzz_$t" "${dict[@]}" -max_total_time="$secs" -max_len=65536 -rss_limit_mb=4096 -timeout=20 \
+    "$build/fuzz_$t" "${dict[@]}" -max_total_time="$secs" -max_len=65536 -rss_limit_mb=4096 -timeout="$timeout" \
     -print_final_stats=1 -artifact_prefix="$crashes/" "$work" >"$log" 2>&1 || true
   # Keep what adds coverage (and every crash) in the repository's corpus.
   "$build/fuzz_$t" -merge=1 "$here/corpus/$t" "$work" >>"$log" 2>&1 || true
