@@ -91,8 +91,9 @@ void NeuralSky::validate(const std::string& where) const {
     for (std::size_t i = 0; i < weights.size(); ++i)
         if (!std::isfinite(weights[i]))
             throw Error(fmt::format("weight {} is not a finite number; train the network again", i), where);
-    if (!(std::isfinite(encoding.max_n) && encoding.max_n > 0.0))
-        throw Error("encoding.max_n must be a positive number", where);
+    // The network runs in float: max{N} must be a float far from its limits.
+    if (!(std::isfinite(encoding.max_n) && encoding.max_n >= 1e-30 && encoding.max_n <= 1e30))
+        throw Error("encoding.max_n must be a number in [1e-30, 1e30] (radiance per unit irradiance, 1/sr)", where);
     if (encoding.brightness == BrightnessEncoding::Log &&
         !(std::isfinite(encoding.log_range) && encoding.log_range > 0.0 && encoding.log_range < 200.0))
         throw Error("encoding.log_range must be in (0, 200) nats", where);

@@ -402,6 +402,8 @@ TEST(NeuralFile, CorruptOrMismatchedFilesAreClearErrors) {
     j = good;
     j["encoding"]["max_n"] = -1.0;
     expect_error(j.dump(), "max_n");
+    j["encoding"]["max_n"] = 1.5e307; // finite in double, infinite radiance in float
+    expect_error(j.dump(), "max_n");
     j = good;
     j["atmosphere"]["planet_radius_km"] = -5.0;
     expect_error(j.dump(), "atmosphere");
