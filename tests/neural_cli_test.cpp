@@ -62,7 +62,10 @@ TEST(NeuralCli, TrainWritesWeightsCurveAndChart) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["topology"], "shared:6x6");
-    EXPECT_EQ(j["weights"], 5 * 6 + 7 * 6 + 7 * 4);
+    // The default encodings: horizon inputs, phase-factored outputs (paper: Rayleigh and Mie, 3 channels each).
+    EXPECT_EQ(j["inputs"], "horizon");
+    EXPECT_EQ(j["outputs"], "phase-factored");
+    EXPECT_EQ(j["weights"], 5 * 6 + 7 * 6 + 7 * 6);
     EXPECT_EQ(j["samples"], 2000);
     EXPECT_GT(j["max_n"].get<double>(), 0.0);
     const auto w = nlohmann::json::parse(read(dir + "/w.json"));
@@ -165,7 +168,7 @@ TEST(NeuralCli, ExportEveryFormat) {
         const std::string out = dir + "/sky." + f;
         auto r = run_cli({"sky", "export", tiny_model(), "--format", f, "-o", out, "--json"});
         ASSERT_EQ(r.exit_code, 0) << r.err;
-        EXPECT_EQ(nlohmann::json::parse(r.out)["weights"], 324);
+        EXPECT_EQ(nlohmann::json::parse(r.out)["weights"], 362); // the default, shared:16x12 with 6 outputs
         EXPECT_NE(read(out).find("skybake_sky("), std::string::npos) << f;
     }
     auto r = run_cli({"sky", "export", tiny_model(), "--format", "metal", "-o", dir + "/sky.metal"});
@@ -201,12 +204,38 @@ TEST(NeuralCli, ErrorReport) {
     EXPECT_NE(t.out.find("day (sun above horizon)"), std::string::npos);
 }
 
+TEST(NeuralCli, TheSeedsNetworkIsOneFlagSet) {
+    const std::string dir = temp_dir("neural_seed");
+    auto r = run_cli({"sky", "train", "--preset", "paper", "--samples", "2000", "--heldout", "300", "--epochs", "2",
+                      "--lm-iterations", "1", "--topology", "paper", "--inputs", "seed", "--outputs", "radiance",
+                      "--brightness", "linear", "--table-rule", "as-published", "--steps", "16", "-o",
+                      dir + "/seed.json", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["topology"], "paper");
+    EXPECT_EQ(j["weights"], 324);
+    const auto w = nlohmann::json::parse(read(dir + "/seed.json"));
+    EXPECT_EQ(w["encoding"]["inputs"], "seed");
+    EXPECT_EQ(w["encoding"]["outputs"], "radiance");
+    EXPECT_EQ(w["encoding"]["brightness"], "linear");
+    // Phase-factored outputs need single scattering: one line naming the flag.
+    auto m = run_cli({"sky", "train", "--preset", "earth", "--scattering", "multiple", "--multiple-method",
+                      "hillaire", "--samples", "100", "--outputs", "phase-factored", "-o", dir + "/m.json"});
+    EXPECT_EQ(m.exit_code, 2) << m.err;
+    EXPECT_EQ(m.err_lines(), 1) << m.err;
+    EXPECT_NE(m.err.find("--outputs"), std::string::npos) << m.err;
+    EXPECT_FALSE(fs::exists(dir + "/m.json"));
+    auto bad = run_cli({"sky", "train", "--inputs", "sideways", "-o", dir + "/b.json"});
+    EXPECT_EQ(bad.exit_code, 2);
+    EXPECT_NE(bad.err.find("--inputs"), std::string::npos) << bad.err;
+}
+
 TEST(NeuralCli, CorruptWeightsAreOneLineErrors) {
     const std::string dir = temp_dir("neural_corrupt");
     const std::string good = read(tiny_model());
     const std::string truncated = write(dir, "truncated.json", good.substr(0, good.size() / 3));
     auto j = nlohmann::json::parse(good);
-    j["weights"][1].erase(0);
+    j["weights"][0].erase(0);
     const std::string short_w = write(dir, "short.json", j.dump());
     const std::string other = write(dir, "other.json", "{\"format\": \"something\"}");
     for (const std::string& f : {truncated, short_w, other, dir + "/missing.json"}) {

@@ -184,6 +184,8 @@ std::string flag_for_field(const std::string& where) {
         {"learning_rate", "--learning-rate"},
         {"log_range", "--log-range"},
         {"brightness", "--brightness"},
+        {"inputs", "--inputs"},
+        {"outputs", "--outputs"},
         {"name", "--name"},
         {"kind", "--kind"},
         {"target_triangles", "--triangles"},

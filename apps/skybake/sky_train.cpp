@@ -12,11 +12,15 @@
 namespace skybake::cli {
 
 void add_sky_train(CLI::App& group) {
-    auto* sub = group.add_subcommand("train", "Train a neural sky (the seed's 324-weight perceptron by default)");
+    auto* sub = group.add_subcommand("train", "Train a neural sky (by default the best network of at most 400 weights; "
+                                              "--topology paper --inputs seed --outputs radiance --brightness linear "
+                                              "is the seed's)");
     struct Opts {
         AtmosphereFlags atm;
         NeuralTrainOptions t;
-        std::string topology = "paper", brightness = "log", output, curve, chart, device = "cpu";
+        // The defaults: the best network of at most 400 weights (docs/neural.md, "Size and accuracy").
+        std::string topology = kDefaultTopology, inputs = "horizon", outputs = "phase-factored", brightness = "log";
+        std::string output, curve, chart, device = "cpu";
         double log_range_decades = 6.0;
         int steps = kTrainingTargetSteps;
         bool json = false;
@@ -29,6 +33,14 @@ void add_sky_train(CLI::App& group) {
     sub->add_option("--topology", o->topology,
                     "paper (4 x 4-8-4-1, 324 weights), independent:W1xW2... or shared:W1xW2...")
         ->capture_default_str();
+    sub->add_option("--inputs", o->inputs,
+                    "Network inputs: horizon (view ray length split at the horizon, altitude coordinate) or seed "
+                    "(the four cosines and density as they are)")
+        ->capture_default_str();
+    sub->add_option("--outputs", o->outputs,
+                    "Network outputs: phase-factored (in-scatter per component, exact phase functions outside; "
+                    "single scattering) or radiance (R/N, G/N, B/N and brightness, as in the seed); default "
+                    "phase-factored, radiance for an atmosphere with multiple scattering");
     sub->add_option("--brightness", o->brightness,
                     "Brightness output M: log (relative accuracy) or linear (as printed; also: seed)")
         ->capture_default_str();
@@ -82,6 +94,16 @@ void add_sky_train(CLI::App& group) {
             atm.table_rule = TableRule::Refined;
         o->t.topology = parse_flag("--topology", [&] { return parse_topology(o->topology); });
         o->t.brightness = parse_flag("--brightness", [&] { return parse_brightness_encoding(o->brightness); });
+        o->t.inputs = parse_flag("--inputs", [&] { return parse_input_encoding(o->inputs); });
+        if (given(*sub, "--outputs")) {
+            o->t.outputs = parse_flag("--outputs", [&] { return parse_output_encoding(o->outputs); });
+            if (o->t.outputs == OutputEncoding::PhaseFactored && atm.scattering != Scattering::Single)
+                throw UsageError("phase-factored outputs are exact for single scattering only; use --outputs "
+                                 "radiance with multiple scattering",
+                                 "--outputs");
+        } else
+            o->t.outputs = atm.scattering == Scattering::Single ? OutputEncoding::PhaseFactored
+                                                                : OutputEncoding::Radiance;
         o->t.log_range = o->log_range_decades * std::log(10.0);
         if (!given(*sub, "--batch"))
             o->t.batch = std::min<std::size_t>(o->t.batch, o->t.samples);
@@ -120,6 +142,8 @@ void add_sky_train(CLI::App& group) {
                         {"topology", net.topology.name()},
                         {"weights", net.topology.weight_count()},
                         {"brightness", o->brightness},
+                        {"inputs", input_encoding_name(net.encoding.inputs)},
+                        {"outputs", output_encoding_name(net.encoding.outputs)},
                         {"samples", s.samples},
                         {"adam_epochs", s.adam_epochs},
                         {"lm_iterations", s.lm_iterations},

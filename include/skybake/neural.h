@@ -11,11 +11,13 @@
 // [SECTION] Learning curves
 // [SECTION] Export to shaders and C
 // [SECTION] Accuracy
+// [SECTION] Look-up table baseline
 // [SECTION] Rendering
 //
 // See docs/neural.md for the maths, the measured errors and examples.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <span>
@@ -45,14 +47,15 @@ namespace skybake {
 // per sub-network, 324 in total.
 struct NeuralTopology {
     std::vector<int> hidden{8, 4}; // widths of the hidden layers: 1 to 7 layers, each 1 to 128 wide
-    bool shared = false;           // false: four independent sub-networks; true: one with four outputs
+    bool shared = false;           // false: one independent sub-network per output; true: one with every output
+    int outputs = 4;               // encoded outputs (NeuralEncoding::output_count()): 4, or 3 per phase term
 
-    int subnet_count() const { return shared ? 1 : 4; }
-    int outputs_per_subnet() const { return shared ? 4 : 1; }
+    int subnet_count() const { return shared ? 1 : outputs; }
+    int outputs_per_subnet() const { return shared ? outputs : 1; }
     // Weights and biases of one sub-network, and of the whole network.
     int subnet_weight_count() const;
     int weight_count() const { return subnet_count() * subnet_weight_count(); }
-    // "paper", "independent:16x16", "shared:64x64".
+    // "paper" (the seed's: independent:8x4 with 4 outputs), "independent:16x16", "shared:64x64".
     std::string name() const;
     // Throws skybake::Error naming `where` when a width or the depth is out of range.
     void validate(const std::string& where = "topology") const;
@@ -86,10 +89,45 @@ enum class BrightnessEncoding : int {
 const char* brightness_encoding_name(BrightnessEncoding encoding);
 BrightnessEncoding parse_brightness_encoding(const std::string& text, const std::string& where = "brightness");
 
+// Inputs. "seed": (cos α0, cos β0, cos θ0, ρ0) as they are. "horizon": the
+// view ray's length to the top or to the ground, split at the horizon as in
+// Bruneton 2017's texture mapping (up rays in [0, 1], ground rays in [−1, 0],
+// the horizon at +1 and −1: the cliff's two sides far apart), cos β0, cos θ0,
+// and Bruneton's altitude coordinate 2√(r² − R0²)/√(Rtop² − R0²) − 1 (the
+// formulas: src/neural/mlp_hd.h, encode_inputs). The geometry comes from the
+// network's atmosphere.
+enum class InputEncoding : int { Seed = 0, Horizon = 1 };
+// Outputs. "radiance": the seed's R/N, G/N, B/N and brightness M (4
+// outputs). "phase-factored": in single scattering with a parallel sun, cos β
+// is the same along the whole view ray, so I = Σ_k P_k(cos β0) S_k exactly,
+// with S_k the in-scatter integral of scattering component k without its
+// phase function. The network learns each S_k per channel (3 outputs per
+// scattering component, each log-encoded over log_range below its own
+// maximum); the exact phase functions are applied outside it.
+enum class OutputEncoding : int { Radiance = 0, PhaseFactored = 1 };
+const char* input_encoding_name(InputEncoding encoding);
+const char* output_encoding_name(OutputEncoding encoding);
+InputEncoding parse_input_encoding(const std::string& text, const std::string& where = "inputs");
+OutputEncoding parse_output_encoding(const std::string& text, const std::string& where = "outputs");
+
+// One phase-factored term: a scattering component of the atmosphere.
+struct PhaseTerm {
+    std::string component;       // its name in the atmosphere ("rayleigh", "mie")
+    PhaseFunction phase = PhaseFunction::Rayleigh;
+    double g = 0.0;
+    glm::dvec3 max_s{1.0};       // per channel, the largest S_k over the max{N} samples (1/km · km = 1)
+};
+
 struct NeuralEncoding {
-    BrightnessEncoding brightness = BrightnessEncoding::Log;
+    InputEncoding inputs = InputEncoding::Seed;
+    OutputEncoding outputs = OutputEncoding::Radiance;
+    BrightnessEncoding brightness = BrightnessEncoding::Log; // Radiance only; phase-factored outputs are log
     double max_n = 1.0;      // max{N} over the max_n samples, radiance per unit sun irradiance (1/sr); > 0
-    double log_range = 13.815510557964274; // Log only: nats of N/max{N} mapped onto M in [0.05, 0.95] (ln 1e6)
+    double log_range = 13.815510557964274; // Log: nats of N/max{N} (or S/max S) mapped onto [0.05, 0.95] (ln 1e6)
+    std::vector<PhaseTerm> terms; // PhaseFactored only: one per scattering component, 1 to 4
+
+    // Encoded outputs: 4 (radiance) or 3 per term.
+    int output_count() const { return outputs == OutputEncoding::Radiance ? 4 : 3 * int(terms.size()); }
 };
 
 // Encoded target (4 values in [0, 1]) of a radiance, and the radiance of 4
@@ -131,8 +169,10 @@ struct NeuralSky {
     void validate(const std::string& where = "neural sky") const;
 };
 
-// JSON (format "skybake-neural-sky", version 1) <-> NeuralSky. Parsing
+// JSON (format "skybake-neural-sky", version 2) <-> NeuralSky. Parsing
 // validates everything and throws skybake::Error naming `where` and the field.
+// Version 1 files (the seed's inputs and outputs, before encodings were
+// selectable) still load, and give the same outputs.
 std::string neural_sky_to_json(const NeuralSky& net);
 NeuralSky neural_sky_from_json(std::string_view text, const std::string& where = "weights JSON");
 NeuralSky load_neural_sky(const std::filesystem::path& path);
@@ -155,8 +195,8 @@ void evaluate_neural_sky_cuda(const NeuralSky& net, std::span<const SkySample> s
 // One sample through the scalar forward pass that shaders and CUDA share
 // (sets up the layout on every call: use evaluate_neural_sky for many samples).
 glm::vec3 neural_sky_radiance(const NeuralSky& net, const SkySample& sample);
-// The 4 encoded outputs (R, G, B, M) of the scalar forward pass.
-void neural_sky_encoded(const NeuralSky& net, const SkySample& sample, float encoded[4]);
+// The encoded outputs of the scalar forward pass (R, G, B, M; or 3 per phase term).
+void neural_sky_encoded(const NeuralSky& net, const SkySample& sample, float* encoded); // topology.outputs values
 
 // [SECTION] Training ------------------------------------------------------------------
 //
@@ -173,10 +213,16 @@ void neural_sky_encoded(const NeuralSky& net, const SkySample& sample, float enc
 // 1.7% and 7.6% for the seed's rule at 256 × 128 and 16 steps (docs/neural.md,
 // "Training targets").
 inline constexpr int kTrainingTargetSteps = 64;
+// The topology `skybake sky train` uses without --topology: with the horizon
+// inputs and phase-factored outputs it is the most accurate network of at most
+// 400 weights we measured (docs/neural.md, "Size and accuracy").
+inline constexpr const char* kDefaultTopology = "shared:16x12";
 inline constexpr TableResolution kTrainingTargetTables{512, 256};
 
 struct NeuralTrainOptions {
-    NeuralTopology topology;
+    NeuralTopology topology;                 // its `outputs` is set from the encoding
+    InputEncoding inputs = InputEncoding::Seed;
+    OutputEncoding outputs = OutputEncoding::Radiance; // PhaseFactored needs single scattering
     BrightnessEncoding brightness = BrightnessEncoding::Log;
     double log_range = 13.815510557964274;   // nats (Log only)
     std::size_t samples = 800000;            // training samples
@@ -294,6 +340,33 @@ struct NeuralErrorOptions {
 };
 
 NeuralErrorReport measure_neural_sky_error(const NeuralSky& net, const NeuralErrorOptions& options = {});
+
+// [SECTION] Look-up table baseline -------------------------------------------------------------
+//
+// What a network must beat: a plain 4D table over the same inputs (the
+// network's input encoding), holding the same encoded outputs at its nodes,
+// interpolated quadrilinearly, as Bruneton 2017 stores its sky. Its nodes are
+// the linear least-squares fit to the training targets (the best table of its
+// size for the network's own loss; a small ridge term keeps nodes that no
+// sample reaches at 0). Used for the size–accuracy curve of docs/neural.md.
+struct SkyLookupTable {
+    NeuralEncoding encoding;
+    Atmosphere atmosphere;          // for the input encoding and the reference
+    SkyModelOptions sky_options;
+    std::array<int, 4> size{};      // nodes per input, ≥ 2 each
+    std::array<float, 4> lo{}, hi{}; // range of each input covered by the nodes
+    std::vector<float> values;      // per node (input 0 fastest), the encoded outputs
+    std::size_t float_count() const { return values.size(); }
+};
+// A table of at most `floats` values (4 bytes each, like a network's
+// weights) with the encodings of `options`, fitted on options.samples
+// targets of `model`'s table path. Throws skybake::Error naming `floats` when
+// not even 2^4 nodes fit.
+SkyLookupTable fit_sky_lookup_table(const SkyModel& model, const NeuralTrainOptions& options, std::size_t floats);
+void evaluate_sky_lookup_table(const SkyLookupTable& table, std::span<const SkySample> samples,
+                               std::span<glm::vec3> out);
+// measure_neural_sky_error for the table (against the same reference model).
+NeuralErrorReport measure_sky_lookup_table_error(const SkyLookupTable& table, const NeuralErrorOptions& options = {});
 
 // [SECTION] Rendering --------------------------------------------------------------------------
 //

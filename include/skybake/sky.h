@@ -165,6 +165,10 @@ void save_atmosphere(const std::filesystem::path& path, const Atmosphere& atmosp
 // cos_theta: cosine of the angle between the view direction and the sun
 // direction (1: looking at the sun). Result in 1/sr.
 double phase_function(PhaseFunction phase, double g, double cos_theta);
+// "none", "rayleigh", "henyey-greenstein", "cornette-shanks", "pietras-rudnicki-mie"
+// (also "seed-mie"), as atmosphere files spell them; parsing throws skybake::Error naming `where`.
+const char* phase_function_name(PhaseFunction phase);
+PhaseFunction parse_phase_function(const std::string& text, const std::string& where = "phase");
 // Relative density of one component at altitude_km above the ground (≥ 0).
 double relative_density(const AtmosphereComponent& component, double altitude_km);
 

@@ -34,24 +34,24 @@ ErrorStats error_stats(std::vector<double>& e) {
     return s;
 }
 
-NeuralErrorReport measure_neural_sky_error(const NeuralSky& net, const NeuralErrorOptions& o) {
-    net.validate("neural sky");
+NeuralErrorReport neural::measure_approximation_error(const SkyModel& model, double max_n,
+                                                     const NeuralErrorOptions& o, const BatchSky& evaluate,
+                                                     const RenderSky& render) {
     if (o.samples < 1 || o.samples > (std::size_t(1) << 28))
         throw Error("the number of samples must be 1 to 2^28", "samples");
     if (o.views && (o.view_width < 1 || o.view_height < 1 || o.view_width > 4096 || o.view_height > 4096))
         throw Error("view size must be 1 to 4096 pixels on each side", "view_width/view_height");
-    const SkyModel model = neural_reference_model(net);
     const std::vector<SkySample> samples = draw_sky_samples(o.samples, o.seed);
     std::vector<glm::vec3> ref(samples.size()), got(samples.size());
     evaluate_sky(model, samples, ref, SkyMethod::Tables);
-    evaluate_neural_sky(net, samples, got);
+    evaluate(samples, got);
 
     std::vector<double> all, day, twilight, night;
     for (std::size_t i = 0; i < samples.size(); ++i) {
         const glm::dvec3 r(ref[i]), g(got[i]);
         const double err = glm::length(g - r);
         if (!(std::max({r.x, r.y, r.z}) > 0.0)) {
-            night.push_back(err / net.encoding.max_n);
+            night.push_back(err / max_n);
             continue;
         }
         const double rel = err / glm::length(r);
@@ -70,7 +70,7 @@ NeuralErrorReport measure_neural_sky_error(const NeuralSky& net, const NeuralErr
         double sum = 0.0, mn = INFINITY;
         for (const PublishedView& v : published_views(o.view_width, o.view_height)) {
             const Image a = render_sky(model, v.settings);
-            const Image b = render_neural_sky(net, model, v.settings);
+            const Image b = render(v.settings);
             ToneMap tm;
             tm.exposure_ev = float(auto_exposure_ev(a));
             const double psnr = image_psnr_db(a, b, tm);
@@ -86,6 +86,15 @@ NeuralErrorReport measure_neural_sky_error(const NeuralSky& net, const NeuralErr
         rep.min_view_psnr_db = mn;
     }
     return rep;
+}
+
+NeuralErrorReport measure_neural_sky_error(const NeuralSky& net, const NeuralErrorOptions& o) {
+    net.validate("neural sky");
+    const SkyModel model = neural_reference_model(net);
+    return neural::measure_approximation_error(
+        model, net.encoding.max_n, o,
+        [&](std::span<const SkySample> s, std::span<glm::vec3> out) { evaluate_neural_sky(net, s, out); },
+        [&](const SkyRenderSettings& v) { return render_neural_sky(net, model, v); });
 }
 
 } // namespace skybake

@@ -33,6 +33,29 @@ inline NeuralSky random_network(const char* topology, unsigned seed) {
     return net;
 }
 
+// The same network with other encodings: phase terms from its atmosphere's
+// scattering components (maxima of a realistic size), and new pseudo-random
+// weights when the output count changes the weight count.
+inline NeuralSky with_encoding(NeuralSky net, InputEncoding inputs, OutputEncoding outputs, unsigned seed) {
+    net.encoding.inputs = inputs;
+    net.encoding.outputs = outputs;
+    net.encoding.brightness = BrightnessEncoding::Log;
+    net.encoding.terms.clear();
+    if (outputs == OutputEncoding::PhaseFactored)
+        for (int k : neural::phase_term_components(net.atmosphere)) {
+            const AtmosphereComponent& c = net.atmosphere.components[std::size_t(k)];
+            net.encoding.terms.push_back({c.name, c.phase, c.phase_g, glm::dvec3(2.0, 4.0, 8.0) * double(k + 1)});
+        }
+    net.topology.outputs = net.encoding.output_count();
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(-1.5f, 1.5f);
+    net.weights.resize(std::size_t(net.topology.weight_count()));
+    for (float& w : net.weights)
+        w = u(rng);
+    net.validate();
+    return net;
+}
+
 // A model of how far the encoded outputs move when every product-sum and
 // every activation rounds differently on the two sides (the GPU's fmaf,
 // ex2.approx and rcp.approx, or expf, against the CPU's summation order and

@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include "neural/error_bound_test_util.h"
 #include "skybake/error.h"
 #include "skybake/neural.h"
 
@@ -50,6 +51,32 @@ NeuralSky make_net(const char* topology, BrightnessEncoding b) {
         w = float(double(state >> 11) * 0x1.0p-53 * 4.0 - 2.0);
     }
     return net;
+}
+
+// The encodings beyond the seed's, on the same topology.
+struct Encoding {
+    InputEncoding inputs;
+    OutputEncoding outputs;
+    const char* name;
+};
+constexpr Encoding kNewEncodings[] = {
+    {InputEncoding::Horizon, OutputEncoding::Radiance, "horizon/radiance"},
+    {InputEncoding::Seed, OutputEncoding::PhaseFactored, "seed/phase-factored"},
+    {InputEncoding::Horizon, OutputEncoding::PhaseFactored, "horizon/phase-factored"},
+};
+
+// Every network the tests below export: two topologies, both brightness codes
+// of the seed's encoding, and each new encoding.
+std::vector<std::pair<std::string, NeuralSky>> export_cases() {
+    std::vector<std::pair<std::string, NeuralSky>> cases;
+    for (const char* top : {"paper", "shared:16x8"}) {
+        cases.emplace_back(fmt::format("{} log", top), make_net(top, BrightnessEncoding::Log));
+        cases.emplace_back(fmt::format("{} linear", top), make_net(top, BrightnessEncoding::Linear));
+        for (const Encoding& e : kNewEncodings)
+            cases.emplace_back(fmt::format("{} {}", top, e.name),
+                               neural_test::with_encoding(make_net(top, BrightnessEncoding::Log), e.inputs, e.outputs, 7));
+    }
+    return cases;
 }
 
 const char* kDriver = R"(
@@ -99,13 +126,13 @@ TEST(NeuralExport, CAndCudaAgreeWithTheLibrary) {
     if (!have("cc") || !have("c++"))
         GTEST_SKIP() << "no system C/C++ compiler";
     const std::vector<SkySample> s = draw_sky_samples(2000, 77);
-    for (const char* top : {"paper", "shared:16x8"}) {
-        for (BrightnessEncoding b : {BrightnessEncoding::Log, BrightnessEncoding::Linear}) {
-            const NeuralSky net = make_net(top, b);
+    for (const auto& [name, net] : export_cases()) {
+        const char* top = name.c_str();
+        {
             std::vector<glm::vec3> batch(s.size());
             evaluate_neural_sky(net, s, batch);
             for (ExportLanguage lang : {ExportLanguage::C, ExportLanguage::Cuda}) {
-                const std::vector<glm::vec3> got = run_exported(net, lang, s, scratch(top));
+                const std::vector<glm::vec3> got = run_exported(net, lang, s, scratch("c"));
                 ASSERT_EQ(got.size(), s.size());
                 double worst_scalar = 0.0, worst_batch = 0.0;
                 int lit = 0;
@@ -133,8 +160,14 @@ TEST(NeuralExport, GlslCompilesInVertexAndFragmentShaders) {
     if (!have("glslangValidator"))
         GTEST_SKIP() << "glslangValidator not installed (Debian package glslang-tools)";
     const fs::path dir = scratch("glsl");
-    for (const char* top : {"paper", "independent:16x16"}) {
-        const std::string fn = export_neural_sky(make_net(top, BrightnessEncoding::Log), ExportLanguage::Glsl);
+    std::vector<std::pair<std::string, NeuralSky>> nets{{"paper", make_net("paper", BrightnessEncoding::Log)},
+                                                        {"independent:16x16",
+                                                         make_net("independent:16x16", BrightnessEncoding::Log)}};
+    for (const Encoding& e : kNewEncodings)
+        nets.emplace_back(e.name, neural_test::with_encoding(make_net("paper", BrightnessEncoding::Log), e.inputs,
+                                                             e.outputs, 3));
+    for (const auto& [top, net] : nets) {
+        const std::string fn = export_neural_sky(net, ExportLanguage::Glsl);
         write(dir / "sky.vert", "#version 330 core\n" + fn +
                                     "layout(location = 0) in vec4 attr;\nout vec3 colour;\n"
                                     "void main() {\n    colour = skybake_sky(attr.x, attr.y, attr.z, attr.w);\n"
@@ -157,14 +190,17 @@ TEST(NeuralExport, HlslCompiles) {
     if (!have("glslangValidator"))
         GTEST_SKIP() << "glslangValidator not installed (Debian package glslang-tools)";
     const fs::path dir = scratch("hlsl");
-    const std::string fn = export_neural_sky(make_net("paper", BrightnessEncoding::Log), ExportLanguage::Hlsl);
-    write(dir / "sky.hlsl", fn + "float4 main(float4 d : TEXCOORD0) : SV_Target {\n"
-                                 "    return float4(skybake_sky(d.x, d.y, d.z, d.w), 1.0f);\n}\n");
-    const std::string cmd = fmt::format("glslangValidator -D -V -e main -S frag -o {} {} > {} 2>&1", (dir / "sky.spv").string(), (dir / "sky.hlsl").string(),
-                                        (dir / "log.txt").string());
-    const int rc = std::system(cmd.c_str());
-    std::ifstream log_file(dir / "log.txt");
-    EXPECT_EQ(rc, 0) << std::string(std::istreambuf_iterator<char>(log_file), {});
+    for (const auto& [name, net] : export_cases()) {
+        const std::string fn = export_neural_sky(net, ExportLanguage::Hlsl);
+        write(dir / "sky.hlsl", fn + "float4 main(float4 d : TEXCOORD0) : SV_Target {\n"
+                                     "    return float4(skybake_sky(d.x, d.y, d.z, d.w), 1.0f);\n}\n");
+        const std::string cmd = fmt::format("glslangValidator -D -V -e main -S frag -o {} {} > {} 2>&1",
+                                            (dir / "sky.spv").string(), (dir / "sky.hlsl").string(),
+                                            (dir / "log.txt").string());
+        const int rc = std::system(cmd.c_str());
+        std::ifstream log_file(dir / "log.txt");
+        EXPECT_EQ(rc, 0) << name << ": " << std::string(std::istreambuf_iterator<char>(log_file), {});
+    }
 }
 
 namespace {
@@ -200,9 +236,9 @@ TEST(NeuralExport, ShaderLiteralsEqualTheCExports) {
     // The C export is checked against the library to 1e-6 above; the GLSL and
     // HLSL only compile. Their numbers must be the C export's, bit for bit and
     // in the same order, so a rounding or a dropped weight in one dialect fails.
-    for (const char* top : {"paper", "independent:16x16", "shared:16x8"})
-        for (BrightnessEncoding b : {BrightnessEncoding::Log, BrightnessEncoding::Linear}) {
-            const NeuralSky net = make_net(top, b);
+    for (const auto& [name, net] : export_cases())
+        {
+            const char* top = name.c_str();
             const std::vector<float> c = float_literals(export_neural_sky(net, ExportLanguage::C));
             ASSERT_GE(c.size(), std::size_t(net.topology.weight_count())) << top;
             // The weights appear among them, each as the float it is.

@@ -2,6 +2,8 @@
 // and backward passes, Jacobians. Shared by inference, training and tests.
 #pragma once
 
+#include <chrono>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -29,6 +31,13 @@ struct Layout {
 
 Layout make_layout(const NeuralTopology& topology);
 MlpHD make_mlp_hd(const NeuralSky& net);
+// The encoding part of MlpHD (inputs, decoding constants, phase terms).
+void set_encoding_hd(const NeuralEncoding& encoding, const Atmosphere& atmosphere, MlpHD& m);
+// Indices of the atmosphere's components that scatter (a phase function and
+// some scattering): the phase-factored terms, in order.
+std::vector<int> phase_term_components(const Atmosphere& atmosphere);
+// 0.05 + 0.9 max(0, 1 + ln(value/max)/log_range), at most 0.95; 0 for value ≤ 0.
+float encode_log(double value, double max, double log_range);
 
 // Per-thread scratch for the batched passes.
 struct Workspace {
@@ -60,7 +69,45 @@ double subnet_normal_equations(const Layout& layout, const float* w, int s, cons
 // Training targets: encoded radiance (4 × n) and mask (4 × n; the R, G, B rows are 0 at night).
 void encode_targets(const NeuralEncoding& encoding, std::span<const glm::vec3> radiance, MatF& targets, MatF& mask);
 
-// Inputs (4 × n) from samples.
-MatF samples_to_matrix(std::span<const SkySample> samples);
+// Phase-factored targets (3 per term × n) from the split sums (n × components,
+// sky::evaluate_sky_split); every output is trained (mask 1).
+void encode_split_targets(const NeuralEncoding& encoding, std::span<const glm::vec3> split, std::size_t components,
+                          const std::vector<int>& term_components, MatF& targets, MatF& mask);
+
+// The random stream `stream` of a training seed: 0 training samples, 1
+// held-out, 2 max{N}, 3 initial weights, 4 shuffles.
+std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t stream);
+
+// Training or held-out data: inputs, encoded targets, masks, and the reference radiance.
+struct TrainingData {
+    MatF x, t, mask;
+    std::vector<glm::vec3> radiance;
+    double mask_count = 0.0;
+    std::size_t size() const { return radiance.size(); }
+};
+// The encoding train_neural_sky trains with: options' encodings, max{N}
+// (and max S per phase term) over options.max_n_samples samples. Throws
+// skybake::Error naming the option for combinations that cannot work.
+NeuralEncoding make_training_encoding(const SkyModel& model, const NeuralTrainOptions& options);
+// n samples (seed) of model's table path with their encoded targets.
+TrainingData make_training_data(const SkyModel& model, const NeuralEncoding& encoding, std::size_t n,
+                                std::uint64_t seed, Device device);
+
+// train_neural_sky after its data: Adam, then Levenberg–Marquardt, on `net`
+// (its topology, encoding and atmosphere set; its weights are replaced).
+// t0: when training started, for the curve's seconds.
+NeuralSky train_network(NeuralSky net, const TrainingData& train, const TrainingData& held,
+                        const NeuralTrainOptions& options, std::vector<LearningCurvePoint>* curve,
+                        std::chrono::steady_clock::time_point t0);
+
+// The held-out errors and view PSNRs of measure_neural_sky_error for any
+// approximation of `model`'s table path: a batch evaluator and a renderer.
+using BatchSky = std::function<void(std::span<const SkySample>, std::span<glm::vec3>)>;
+using RenderSky = std::function<Image(const SkyRenderSettings&)>;
+NeuralErrorReport measure_approximation_error(const SkyModel& model, double max_n, const NeuralErrorOptions& options,
+                                              const BatchSky& evaluate, const RenderSky& render);
+
+// Network inputs (4 × n) from samples, through the input encoding of m.
+MatF samples_to_matrix(const MlpHD& m, std::span<const SkySample> samples);
 
 } // namespace skybake::neural

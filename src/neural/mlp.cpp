@@ -67,10 +67,39 @@ MlpHD make_mlp_hd(const NeuralSky& net) {
     for (int l = 0; l < m.layers; ++l)
         m.width[l + 1] = lay.layers[std::size_t(l)].out;
     m.subnet_params = lay.subnet_params;
-    m.brightness = net.encoding.brightness == BrightnessEncoding::Linear ? kBrightnessLinear : kBrightnessLog;
-    m.max_n = float(net.encoding.max_n);
-    m.log_range = float(net.encoding.log_range);
+    m.outputs = net.topology.outputs;
+    set_encoding_hd(net.encoding, net.atmosphere, m);
     return m;
+}
+
+void set_encoding_hd(const NeuralEncoding& e, const Atmosphere& atmosphere, MlpHD& m) {
+    m.brightness = e.brightness == BrightnessEncoding::Linear ? kBrightnessLinear : kBrightnessLog;
+    m.max_n = float(e.max_n);
+    m.log_range = float(e.log_range);
+    m.inputs = e.inputs == InputEncoding::Horizon ? kInputsHorizon : kInputsSeed;
+    m.R0 = float(atmosphere.planet_radius_km);
+    m.Rtop = float(atmosphere.top_radius_km);
+    m.scale_height = atmosphere.components.empty() ? 8.0f : float(atmosphere.components[0].scale_height_km);
+    m.output_kind = e.outputs == OutputEncoding::PhaseFactored ? kOutputsPhaseFactored : kOutputsRadiance;
+    m.terms = e.outputs == OutputEncoding::PhaseFactored ? int(std::min<std::size_t>(e.terms.size(), kMaxTerms)) : 0;
+    for (int k = 0; k < m.terms; ++k) {
+        const PhaseTerm& t = e.terms[std::size_t(k)];
+        m.term_phase[k] = int(t.phase);
+        m.term_g[k] = float(t.g);
+        for (int c = 0; c < 3; ++c)
+            m.term_max[k][c] = float(t.max_s[c]);
+    }
+}
+
+std::vector<int> phase_term_components(const Atmosphere& atmosphere) {
+    std::vector<int> k;
+    for (std::size_t i = 0; i < atmosphere.components.size(); ++i) {
+        const AtmosphereComponent& c = atmosphere.components[i];
+        if (c.phase != PhaseFunction::None && std::max({c.scattering_per_km.x, c.scattering_per_km.y,
+                                                        c.scattering_per_km.z}) > 0.0)
+            k.push_back(int(i));
+    }
+    return k;
 }
 
 void forward_subnet(const Layout& layout, const float* w, const Eigen::Ref<const MatF>& x, Workspace& ws) {
@@ -178,7 +207,7 @@ void encode_targets(const NeuralEncoding& encoding, std::span<const glm::vec3> r
     parallel_for(radiance.size(), 4096, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
             float enc[4];
-            encode_sky_radiance(encoding, radiance[i], enc);
+            encode_sky_radiance(encoding, radiance[i], enc); // radiance outputs
             const bool night = !(std::max({radiance[i].x, radiance[i].y, radiance[i].z}) > 0.0f);
             for (int k = 0; k < 4; ++k) {
                 targets(k, Eigen::Index(i)) = enc[k];
@@ -188,13 +217,35 @@ void encode_targets(const NeuralEncoding& encoding, std::span<const glm::vec3> r
     });
 }
 
-MatF samples_to_matrix(std::span<const SkySample> samples) {
+void encode_split_targets(const NeuralEncoding& encoding, std::span<const glm::vec3> split, std::size_t components,
+                          const std::vector<int>& term_components, MatF& targets, MatF& mask) {
+    const std::size_t n = split.size() / components;
+    const int outputs = 3 * int(term_components.size());
+    targets.resize(outputs, Eigen::Index(n));
+    mask.setOnes(outputs, Eigen::Index(n));
+    parallel_for(n, 4096, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i)
+            for (std::size_t k = 0; k < term_components.size(); ++k) {
+                const glm::vec3 v = split[i * components + std::size_t(term_components[k])];
+                for (int c = 0; c < 3; ++c)
+                    targets(Eigen::Index(3 * k + std::size_t(c)), Eigen::Index(i)) =
+                        encode_log(double(v[c]), encoding.terms[k].max_s[c], encoding.log_range);
+            }
+    });
+}
+
+float encode_log(double value, double max, double log_range) {
+    if (!(value > 0.0))
+        return 0.0f; // no light: below the offset, decoded as 0
+    const double m = std::max(0.0, 1.0 + std::log(value / max) / log_range);
+    return float(kEncodeOffset + kEncodeScale * std::min(m, 1.0));
+}
+
+MatF samples_to_matrix(const MlpHD& m, std::span<const SkySample> samples) {
     MatF x(4, Eigen::Index(samples.size()));
     for (std::size_t i = 0; i < samples.size(); ++i) {
-        x(0, Eigen::Index(i)) = samples[i].cos_view_zenith;
-        x(1, Eigen::Index(i)) = samples[i].cos_view_sun;
-        x(2, Eigen::Index(i)) = samples[i].cos_sun_zenith;
-        x(3, Eigen::Index(i)) = samples[i].density;
+        const SkySample& s = samples[i];
+        encode_inputs(m, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, x.col(Eigen::Index(i)).data());
     }
     return x;
 }
@@ -210,19 +261,17 @@ void encode_sky_radiance(const NeuralEncoding& e, const glm::vec3& c, float enc[
     enc[0] = kEncodeOffset + kEncodeScale * std::max(0.0f, c.x) / n;
     enc[1] = kEncodeOffset + kEncodeScale * std::max(0.0f, c.y) / n;
     enc[2] = kEncodeOffset + kEncodeScale * std::max(0.0f, c.z) / n;
-    double m;
     if (e.brightness == BrightnessEncoding::Linear)
-        m = double(n) / e.max_n;
+        enc[3] = float(kEncodeOffset + kEncodeScale * std::min(double(n) / e.max_n, 1.0));
     else
-        m = std::max(0.0, 1.0 + std::log(double(n) / e.max_n) / e.log_range);
-    enc[3] = float(kEncodeOffset + kEncodeScale * std::min(m, 1.0));
+        enc[3] = encode_log(double(n), e.max_n, e.log_range);
 }
 
 glm::vec3 decode_sky_radiance(const NeuralEncoding& e, const float enc[4]) {
     MlpHD m;
-    m.brightness = e.brightness == BrightnessEncoding::Linear ? kBrightnessLinear : kBrightnessLog;
-    m.max_n = float(e.max_n);
-    m.log_range = float(e.log_range);
+    NeuralEncoding radiance = e;
+    radiance.outputs = OutputEncoding::Radiance;
+    set_encoding_hd(radiance, Atmosphere{}, m);
     return decode_sky(m, enc);
 }
 
@@ -235,15 +284,15 @@ void evaluate_neural_sky(const NeuralSky& net, std::span<const SkySample> sample
     const std::size_t blocks = (samples.size() + kBlock - 1) / kBlock;
     parallel_for(blocks, 1, [&](std::size_t b0, std::size_t b1) {
         Workspace ws;
-        MatF enc(4, Eigen::Index(kBlock));
+        MatF enc(hd.outputs, Eigen::Index(kBlock));
         for (std::size_t b = b0; b < b1; ++b) {
             const std::size_t lo = b * kBlock, hi = std::min(samples.size(), lo + kBlock);
-            const MatF x = samples_to_matrix(samples.subspan(lo, hi - lo));
-            enc.resize(4, x.cols());
+            const MatF x = samples_to_matrix(hd, samples.subspan(lo, hi - lo));
+            enc.resize(hd.outputs, x.cols());
             forward_network(layout, net.weights.data(), x, enc, ws);
             for (std::size_t i = lo; i < hi; ++i) {
                 assert(is_valid_sky_sample(samples[i], 1e-4));
-                out[i] = decode_sky(hd, enc.col(Eigen::Index(i - lo)).data());
+                out[i] = decode_sky(hd, enc.col(Eigen::Index(i - lo)).data(), samples[i].cos_view_sun);
             }
         }
     });
@@ -254,9 +303,10 @@ glm::vec3 neural_sky_radiance(const NeuralSky& net, const SkySample& s) {
     return neural_sky(hd, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density);
 }
 
-void neural_sky_encoded(const NeuralSky& net, const SkySample& s, float enc[4]) {
+void neural_sky_encoded(const NeuralSky& net, const SkySample& s, float* enc) {
     const MlpHD hd = make_mlp_hd(net);
-    const float in[4] = {s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density};
+    float in[kInputs];
+    encode_inputs(hd, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, in);
     mlp_forward(hd, in, enc);
 }
 

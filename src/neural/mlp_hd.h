@@ -16,11 +16,14 @@
 #include <glm/vec3.hpp>
 
 #include "core/hd.h"
+#include "sky/sky_hd.h"
 
 namespace skybake::neural {
 
 constexpr int kInputs = 4;
-constexpr int kOutputs = 4;
+constexpr int kOutputs = 4;     // the seed's outputs: R, G, B, M
+constexpr int kMaxTerms = 4;    // phase-factored: one RGB term per scattering component
+constexpr int kMaxOutputs = 3 * kMaxTerms;
 constexpr int kMaxHidden = 7;              // hidden layers
 constexpr int kMaxLayers = kMaxHidden + 1; // weight layers
 constexpr int kMaxWidth = 128;
@@ -30,21 +33,32 @@ constexpr float kEncodeScale = 0.9f;
 constexpr float kSlope = 1.38629436111989f;
 
 enum : int { kBrightnessLinear = 0, kBrightnessLog = 1 };
+// Values of skybake::InputEncoding and OutputEncoding.
+enum : int { kInputsSeed = 0, kInputsHorizon = 1 };
+enum : int { kOutputsRadiance = 0, kOutputsPhaseFactored = 1 };
 
 struct MlpHD {
     const float* weights = nullptr; // subnets * subnet_params floats
-    int subnets = 4;                // 4: independent (R, G, B, M); 1: shared
+    int subnets = 4;                // outputs: independent (R, G, B, M); 1: shared
     int layers = 3;                 // weight layers (hidden + 1)
     int width[kMaxLayers + 1] = {4, 8, 4, 1}; // width[0] = 4 inputs, width[layers] = outputs per sub-network
     int subnet_params = 81;
+    int outputs = kOutputs;         // encoded outputs of the whole network
     int brightness = kBrightnessLog;
     float max_n = 1.0f;             // 1/sr
     float log_range = 13.8155106f;  // nats
+    // Input encoding and the geometry the horizon inputs need (km).
+    int inputs = kInputsSeed;
+    float R0 = 6360.0f, Rtop = 6420.0f, scale_height = 8.0f;
+    // Output encoding; phase-factored: per term its phase function (sky::phase_value's kind and g) and
+    // per-channel maximum (1/sr).
+    int output_kind = kOutputsRadiance;
+    int terms = 0;
+    int term_phase[kMaxTerms] = {};
+    float term_g[kMaxTerms] = {};
+    float term_max[kMaxTerms][3] = {};
 };
 
-// The seed's activation, as printed. Its vertex program computes
-// 1/(1 + 2^(−2x)) = 1 − f(x) (MUL by −2.0, EX2, ADD 1, RCP): the same networks
-// with the signs of every neuron's incoming weights and bias flipped.
 SKYBAKE_HD_INLINE float seed_activation(float x) { return 1.0f / (1.0f + exp2f(2.0f * x)); }
 
 // One sub-network: in[width[0]] -> out[width[layers]].
@@ -67,8 +81,8 @@ SKYBAKE_HD_INLINE void mlp_subnet_forward(const MlpHD& m, const float* w, const 
     }
 }
 
-// The four encoded outputs (R, G, B, M) for inputs (cos α0, cos β0, cos θ0, ρ0).
-SKYBAKE_HD_INLINE void mlp_forward(const MlpHD& m, const float in[kInputs], float enc[kOutputs]) {
+// The network's encoded outputs (m.outputs of them) for its 4 inputs.
+SKYBAKE_HD_INLINE void mlp_forward(const MlpHD& m, const float in[kInputs], float* enc) {
     if (m.subnets == 1) {
         mlp_subnet_forward(m, m.weights, in, enc);
         return;
@@ -77,14 +91,80 @@ SKYBAKE_HD_INLINE void mlp_forward(const MlpHD& m, const float in[kInputs], floa
         mlp_subnet_forward(m, m.weights + s * m.subnet_params, in, enc + s);
 }
 
+// The network's inputs from the sky function's arguments.
+//  seed:    (cos α0, cos β0, cos θ0, ρ0) as they are.
+//  horizon: altitude h = −H ln ρ0 (H: scale height of the first component),
+//           r = R0 + h, ρ = √(r² − R0²), Ĥ = √(Rtop² − R0²); then
+//   in0: the view ray's length d to where it leaves the atmosphere or meets
+//        the ground, as in Bruneton 2017's texture mapping: up rays
+//        (d − dmin)/(dmax − dmin) in [0, 1] with dmin = Rtop − r, dmax = ρ + Ĥ;
+//        ground rays −(d − dmin)/(dmax − dmin) in [−1, 0] with dmin = h,
+//        dmax = ρ. The horizon seen from above is +1, from below −1: the
+//        cliff between them is as far apart as the input allows.
+//   in1: cos β0.
+//   in2: cos θ0. (The sun's elevation above the observer's dipped horizon,
+//        (asin cos θ0 + atan(ρ/R0)) / (π/2), was tried and measured worse:
+//        docs/neural.md.)
+//   in3: 2 ρ/Ĥ − 1 (Bruneton's r coordinate: fine near the ground).
+SKYBAKE_HD_INLINE void encode_inputs(const MlpHD& m, float cos_view_zenith, float cos_view_sun, float cos_sun_zenith,
+                                     float density, float in[kInputs]) {
+    in[1] = cos_view_sun;
+    in[2] = cos_sun_zenith;
+    if (m.inputs != kInputsHorizon) {
+        in[0] = cos_view_zenith;
+        in[3] = density;
+        return;
+    }
+    const float top = m.Rtop - m.R0;
+    float h = -m.scale_height * logf(density);
+    h = h > 0.0f ? (h < top ? h : top) : 0.0f;
+    const float r = m.R0 + h;
+    const float rho = sqrtf(h * (2.0f * m.R0 + h));     // √(r² − R0²)
+    const float H = sqrtf(top * (2.0f * m.R0 + top));   // √(Rtop² − R0²)
+    const float rc = r * cos_view_zenith;
+    const float arc = fabsf(rc);
+    if (cos_view_zenith < 0.0f && arc >= rho) { // the ray meets the ground
+        const float disc = (arc - rho) * (arc + rho);  // r² cos² − ρ²
+        const float d = -rc - sqrtf(disc > 0.0f ? disc : 0.0f);
+        const float span = rho - h;
+        const float t = span > 0.0f ? (d - h) / span : 0.0f;
+        in[0] = -(t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f);
+    } else {
+        const float disc = rc * rc + (top - h) * (2.0f * m.R0 + top + h); // r² cos² + Rtop² − r²
+        const float d = -rc + sqrtf(disc > 0.0f ? disc : 0.0f);
+        const float span = rho + H - (top - h);
+        const float t = span > 0.0f ? (d - (top - h)) / span : 0.0f;
+        in[0] = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
+    }
+    in[3] = 2.0f * rho / H - 1.0f;
+}
+
 // Encoded value -> [0, ...): (x − 0.05)/0.9, values below 0.05 are 0.
 SKYBAKE_HD_INLINE float decode_unit(float x) {
     const float v = (x - kEncodeOffset) * (1.0f / kEncodeScale);
     return v > 0.0f ? v : 0.0f;
 }
 
-// Radiance (1/sr) from the encoded outputs: (R, G, B) · N.
-SKYBAKE_HD_INLINE glm::vec3 decode_sky(const MlpHD& m, const float enc[kOutputs]) {
+// A log-encoded value: 0 below the offset (night), else max · e^(D (x' − 1)).
+SKYBAKE_HD_INLINE float decode_log(float x, float max, float log_range) {
+    const float v = (x - kEncodeOffset) * (1.0f / kEncodeScale);
+    return v > 0.0f ? max * expf(log_range * (v - 1.0f)) : 0.0f;
+}
+
+// Radiance (1/sr) from the encoded outputs.
+//  radiance:       (R, G, B) · N, N from the brightness output M.
+//  phase-factored: Σ_k P_k(cos β0) S_k, each channel of S_k log-encoded.
+SKYBAKE_HD_INLINE glm::vec3 decode_sky(const MlpHD& m, const float* enc, float cos_view_sun = 1.0f) {
+    if (m.output_kind == kOutputsPhaseFactored) {
+        glm::vec3 c(0.0f);
+        for (int k = 0; k < m.terms; ++k) {
+            const float p = sky::phase_value(m.term_phase[k], m.term_g[k], cos_view_sun);
+            c.x += p * decode_log(enc[3 * k + 0], m.term_max[k][0], m.log_range);
+            c.y += p * decode_log(enc[3 * k + 1], m.term_max[k][1], m.log_range);
+            c.z += p * decode_log(enc[3 * k + 2], m.term_max[k][2], m.log_range);
+        }
+        return c;
+    }
     const float mm = (enc[3] - kEncodeOffset) * (1.0f / kEncodeScale);
     if (!(mm > 0.0f))
         return glm::vec3(0.0f); // night
@@ -94,10 +174,11 @@ SKYBAKE_HD_INLINE glm::vec3 decode_sky(const MlpHD& m, const float enc[kOutputs]
 
 SKYBAKE_HD_INLINE glm::vec3 neural_sky(const MlpHD& m, float cos_view_zenith, float cos_view_sun,
                                        float cos_sun_zenith, float density) {
-    const float in[kInputs] = {cos_view_zenith, cos_view_sun, cos_sun_zenith, density};
-    float enc[kOutputs];
+    float in[kInputs];
+    encode_inputs(m, cos_view_zenith, cos_view_sun, cos_sun_zenith, density, in);
+    float enc[kMaxOutputs];
     mlp_forward(m, in, enc);
-    return decode_sky(m, enc);
+    return decode_sky(m, enc, cos_view_sun);
 }
 
 } // namespace skybake::neural

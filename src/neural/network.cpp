@@ -19,7 +19,7 @@ using json = nlohmann::json;
 namespace {
 
 constexpr const char* kFormat = "skybake-neural-sky";
-constexpr int kVersion = 1;
+constexpr int kVersion = 2; // 2: input and output encodings, topology.outputs; 1 still loads
 
 } // namespace
 
@@ -33,7 +33,7 @@ int NeuralTopology::subnet_weight_count() const {
 }
 
 std::string NeuralTopology::name() const {
-    if (!shared && hidden == std::vector<int>{8, 4})
+    if (!shared && outputs == 4 && hidden == std::vector<int>{8, 4})
         return "paper";
     std::string s = shared ? "shared:" : "independent:";
     for (std::size_t i = 0; i < hidden.size(); ++i)
@@ -48,6 +48,8 @@ void NeuralTopology::validate(const std::string& where) const {
     for (int w : hidden)
         if (w < 1 || w > neural::kMaxWidth)
             throw Error(fmt::format("hidden layer width {} is outside 1..{}", w, neural::kMaxWidth), where);
+    if (outputs < 1 || outputs > neural::kMaxOutputs)
+        throw Error(fmt::format("a network has 1 to {} outputs, not {}", neural::kMaxOutputs, outputs), where);
 }
 
 NeuralTopology parse_topology(std::string_view text, const std::string& where) {
@@ -94,25 +96,64 @@ void NeuralSky::validate(const std::string& where) const {
     // The network runs in float: max{N} must be a float far from its limits.
     if (!(std::isfinite(encoding.max_n) && encoding.max_n >= 1e-30 && encoding.max_n <= 1e30))
         throw Error("encoding.max_n must be a number in [1e-30, 1e30] (radiance per unit irradiance, 1/sr)", where);
-    if (encoding.brightness == BrightnessEncoding::Log &&
+    if ((encoding.brightness == BrightnessEncoding::Log || encoding.outputs == OutputEncoding::PhaseFactored) &&
         !(std::isfinite(encoding.log_range) && encoding.log_range > 0.0 && encoding.log_range < 200.0))
         throw Error("encoding.log_range must be in (0, 200) nats", where);
+    if (encoding.outputs == OutputEncoding::PhaseFactored) {
+        if (encoding.terms.empty() || int(encoding.terms.size()) > neural::kMaxTerms)
+            throw Error(fmt::format("phase-factored outputs need 1 to {} terms, not {}", neural::kMaxTerms,
+                                    encoding.terms.size()),
+                        where + ": encoding.terms");
+        if (encoding.brightness != BrightnessEncoding::Log)
+            throw Error("phase-factored outputs are log-encoded: encoding.brightness must be log", where);
+        for (const PhaseTerm& t : encoding.terms) {
+            if (t.phase == PhaseFunction::None || !(std::isfinite(t.g) && std::abs(t.g) < 1.0))
+                throw Error("a phase term needs a phase function and g in (-1, 1)", where + ": encoding.terms");
+            for (int c = 0; c < 3; ++c)
+                if (!(std::isfinite(t.max_s[c]) && t.max_s[c] >= 1e-30 && t.max_s[c] <= 1e30))
+                    throw Error("a phase term's max_s must be numbers in [1e-30, 1e30]", where + ": encoding.terms");
+        }
+    } else if (!encoding.terms.empty()) {
+        throw Error("radiance outputs have no phase terms", where + ": encoding.terms");
+    }
+    if (topology.outputs != encoding.output_count())
+        throw Error(fmt::format("topology.outputs is {} but the {} encoding has {} outputs", topology.outputs,
+                                output_encoding_name(encoding.outputs), encoding.output_count()),
+                    where);
 }
 
 std::string neural_sky_to_json(const NeuralSky& net) {
     json j;
     j["format"] = kFormat;
     j["version"] = kVersion;
+    const NeuralEncoding& e = net.encoding;
+    const bool factored = e.outputs == OutputEncoding::PhaseFactored;
     j["topology"] = {{"name", net.topology.name()},
                      {"kind", net.topology.shared ? "shared" : "independent"},
                      {"hidden", net.topology.hidden},
-                     {"inputs", "cos_view_zenith, cos_view_sun, cos_sun_zenith, density"},
-                     {"outputs", "R/N, G/N, B/N, M (each as 0.05 + 0.9 value)"},
+                     {"outputs", net.topology.outputs},
+                     {"input_meaning", e.inputs == InputEncoding::Seed
+                                           ? "cos_view_zenith, cos_view_sun, cos_sun_zenith, density"
+                                           : "view ray length split at the horizon, cos_view_sun, cos_sun_zenith, "
+                                             "altitude coordinate"},
+                     {"output_meaning", factored ? "per term, S_r, S_g, S_b (log, each as 0.05 + 0.9 value)"
+                                                 : "R/N, G/N, B/N, M (each as 0.05 + 0.9 value)"},
                      {"activation", "1/(1+2^(2x))"},
                      {"weight_count", net.topology.weight_count()}};
-    j["encoding"] = {{"brightness", brightness_encoding_name(net.encoding.brightness)},
-                     {"max_n", net.encoding.max_n},
-                     {"log_range", net.encoding.log_range}};
+    j["encoding"] = {{"inputs", input_encoding_name(e.inputs)},
+                     {"outputs", output_encoding_name(e.outputs)},
+                     {"brightness", brightness_encoding_name(e.brightness)},
+                     {"max_n", e.max_n},
+                     {"log_range", e.log_range}};
+    if (factored) {
+        json terms = json::array();
+        for (const PhaseTerm& t : e.terms)
+            terms.push_back({{"component", t.component},
+                             {"phase", phase_function_name(t.phase)},
+                             {"g", t.g},
+                             {"max_s", {t.max_s.x, t.max_s.y, t.max_s.z}}});
+        j["encoding"]["terms"] = std::move(terms);
+    }
     json subnets = json::array();
     const std::size_t per = std::size_t(net.topology.subnet_weight_count());
     for (int s = 0; s < net.topology.subnet_count(); ++s) {
@@ -176,8 +217,11 @@ NeuralSky neural_sky_from_json(std::string_view text, const std::string& where) 
     }
     if (!j.is_object() || !j.contains("format") || j["format"] != kFormat)
         throw Error(fmt::format("not a neural sky weights file (expected \"format\": \"{}\")", kFormat), where);
-    if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<int>() != kVersion)
-        throw Error(fmt::format("unsupported weights file version (this build reads version {})", kVersion), where);
+    if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<long long>() < 1 ||
+        j["version"].get<long long>() > kVersion)
+        throw Error(fmt::format("unsupported weights file version (this build reads versions 1 to {})", kVersion),
+                    where);
+    const int version = j["version"].get<int>();
     NeuralSky net;
     try {
         const json& top = field(j, "topology", where);
@@ -203,6 +247,40 @@ NeuralSky neural_sky_from_json(std::string_view text, const std::string& where) 
         net.encoding.brightness = parse_brightness_encoding(b.get<std::string>(), where + ": encoding.brightness");
         net.encoding.max_n = number(enc, "max_n", where + ": encoding");
         net.encoding.log_range = number(enc, "log_range", where + ": encoding");
+        if (version >= 2) { // version 1: the seed's inputs and radiance outputs
+            const json& in = field(enc, "inputs", where + ": encoding");
+            const json& out = field(enc, "outputs", where + ": encoding");
+            if (!in.is_string() || !out.is_string())
+                throw Error("encoding.inputs and encoding.outputs must be names", where);
+            net.encoding.inputs = parse_input_encoding(in.get<std::string>(), where + ": encoding.inputs");
+            net.encoding.outputs = parse_output_encoding(out.get<std::string>(), where + ": encoding.outputs");
+            if (net.encoding.outputs == OutputEncoding::PhaseFactored) {
+                const json& terms = field(enc, "terms", where + ": encoding");
+                if (!terms.is_array() || terms.empty() || int(terms.size()) > neural::kMaxTerms)
+                    throw Error(fmt::format("encoding.terms must be an array of 1 to {} terms", neural::kMaxTerms),
+                                where);
+                for (const json& t : terms) {
+                    const std::string tw = where + ": encoding.terms";
+                    PhaseTerm p;
+                    const json& c = field(t, "component", tw);
+                    const json& ph = field(t, "phase", tw);
+                    const json& mx = field(t, "max_s", tw);
+                    if (!c.is_string() || !ph.is_string() || !mx.is_array() || mx.size() != 3 ||
+                        !mx[0].is_number() || !mx[1].is_number() || !mx[2].is_number())
+                        throw Error("a term needs a component name, a phase name, g and max_s [r, g, b]", tw);
+                    p.component = c.get<std::string>();
+                    p.phase = parse_phase_function(ph.get<std::string>(), tw + ".phase");
+                    p.g = number(t, "g", tw);
+                    p.max_s = glm::dvec3(mx[0].get<double>(), mx[1].get<double>(), mx[2].get<double>());
+                    net.encoding.terms.push_back(p);
+                }
+            }
+            net.topology.outputs = integer(top, "outputs", where + ": topology", 1, neural::kMaxOutputs);
+            if (net.topology.outputs != net.encoding.output_count())
+                throw Error(fmt::format("topology.outputs is {} but the encoding has {} outputs",
+                                        net.topology.outputs, net.encoding.output_count()),
+                            where);
+        }
 
         const json& w = field(j, "weights", where);
         if (!w.is_array())
@@ -276,7 +354,24 @@ constexpr NamedValue<BrightnessEncoding> kBrightnessNames[] = {
     {BrightnessEncoding::Linear, "linear", "the paper's", "seed"},
     {BrightnessEncoding::Log, "log", "a fixed relative error over many decades"},
 };
+constexpr NamedValue<InputEncoding> kInputNames[] = {
+    {InputEncoding::Seed, "seed", "(cos a0, cos b0, cos t0, rho0) as in the seed"},
+    {InputEncoding::Horizon, "horizon", "ray length split at the horizon, cos b0, cos t0, altitude"},
+};
+constexpr NamedValue<OutputEncoding> kOutputNames[] = {
+    {OutputEncoding::Radiance, "radiance", "R/N, G/N, B/N and brightness, as in the seed"},
+    {OutputEncoding::PhaseFactored, "phase-factored", "phase-free in-scatter per component, exact phase outside"},
+};
 } // namespace
+
+const char* input_encoding_name(InputEncoding encoding) { return name_of(kInputNames, encoding); }
+const char* output_encoding_name(OutputEncoding encoding) { return name_of(kOutputNames, encoding); }
+InputEncoding parse_input_encoding(const std::string& text, const std::string& where) {
+    return parse_name(kInputNames, text, "input encoding", where);
+}
+OutputEncoding parse_output_encoding(const std::string& text, const std::string& where) {
+    return parse_name(kOutputNames, text, "output encoding", where);
+}
 
 const char* brightness_encoding_name(BrightnessEncoding encoding) { return name_of(kBrightnessNames, encoding); }
 

@@ -88,11 +88,12 @@ __device__ __forceinline__ glm::vec3 seed_network(const MlpHD& m, const float in
 }
 
 // `weights` is a device buffer, or nullptr for the constant-memory copy.
+// `in` are the network's inputs (encode_inputs); in[1] is cos β0 in every encoding.
 __device__ __forceinline__ glm::vec3 generic_network(MlpHD m, const float* weights, const float in[4]) {
     m.weights = weights ? weights : c_weights;
-    float enc[kOutputs];
+    float enc[kMaxOutputs];
     mlp_forward(m, in, enc);
-    return decode_sky(m, enc);
+    return decode_sky(m, enc, in[1]);
 }
 
 template <bool Fixed>
@@ -102,7 +103,8 @@ __global__ void neural_kernel(MlpHD m, const float* weights, const SkySample* sa
     if (i >= n)
         return;
     const SkySample s = samples[i];
-    const float in[4] = {s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density};
+    float in[kInputs];
+    encode_inputs(m, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, in);
     out[i] = Fixed ? seed_network(m, in) : generic_network(m, weights, in);
 }
 
@@ -111,8 +113,9 @@ __global__ void throughput_kernel(MlpHD m, const float* weights, std::uint64_t n
     float acc = 0.0f;
     const std::uint64_t stride = std::uint64_t(gridDim.x) * blockDim.x;
     for (std::uint64_t i = std::uint64_t(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) {
-        float in[4];
-        throughput_inputs(std::uint32_t(i), in);
+        float x[4], in[kInputs];
+        throughput_inputs(std::uint32_t(i), x);
+        encode_inputs(m, x[0], x[1], x[2], x[3], in);
         const glm::vec3 c = Fixed ? seed_network(m, in) : generic_network(m, weights, in);
         acc += c.x + c.y + c.z;
     }
@@ -134,8 +137,8 @@ __global__ void neural_render_kernel(sky::RenderHD p, MlpHD m, const float* weig
 }
 
 bool is_seed_topology(const MlpHD& m) {
-    return m.subnets == 4 && m.layers == 3 && m.width[0] == 4 && m.width[1] == 8 && m.width[2] == 4 &&
-           m.width[3] == 1 && m.subnet_params == 81;
+    return m.output_kind == kOutputsRadiance && m.subnets == 4 && m.layers == 3 && m.width[0] == 4 &&
+           m.width[1] == 8 && m.width[2] == 4 && m.width[3] == 1 && m.subnet_params == 81;
 }
 
 // Puts the weights where the kernels read them: constant memory when they fit

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "neural/internal.h"
+#include "sky/internal.h"
 #include "skybake/core.h"
 #include "skybake/error.h"
 #include "skybake/neural.h"
@@ -510,4 +511,219 @@ TEST(SkySource, EvaluatesAndRendersAsTheFunctionsItChoosesBetween) {
             EXPECT_EQ(e.where(), "device");
         }
     }
+}
+
+// ---- encodings beyond the seed's -------------------------------------------------------
+
+TEST(NeuralEncoding, HorizonInputsPutTheHorizonsSidesFarApart) {
+    NeuralEncoding e;
+    e.inputs = InputEncoding::Horizon;
+    MlpHD m;
+    const Atmosphere atm = atmosphere_preset("earth");
+    set_encoding_hd(e, atm, m);
+    const double R0 = atm.planet_radius_km, H = atm.components[0].scale_height_km;
+    for (double h : {0.1, 2.0, 30.0}) {
+        const float rho = float(std::exp(-h / H));
+        const double horizon = -std::sqrt(1.0 - (R0 / (R0 + h)) * (R0 / (R0 + h))); // cos of the horizon
+        float in[4];
+        encode_inputs(m, 1.0f, 0.3f, 0.5f, rho, in);
+        EXPECT_NEAR(in[0], 0.0f, 1e-4) << h; // zenith: the shortest up ray
+        EXPECT_FLOAT_EQ(in[1], 0.3f);
+        encode_inputs(m, float(horizon + 1e-5), 0.3f, 0.5f, rho, in);
+        EXPECT_GT(in[0], 0.95f) << h; // just above the horizon: near +1
+        encode_inputs(m, float(horizon - 1e-5), 0.3f, 0.5f, rho, in);
+        EXPECT_LT(in[0], -0.9f) << h; // just below: near −1
+        encode_inputs(m, -1.0f, 0.3f, 0.5f, rho, in);
+        EXPECT_NEAR(in[0], 0.0f, 1e-3) << h; // nadir: the shortest ground ray
+        // Bruneton's altitude coordinate, in [−1, 1].
+        const double top = atm.top_radius_km - R0;
+        EXPECT_NEAR(in[3], 2.0 * std::sqrt(h * (2.0 * R0 + h) / (top * (2.0 * R0 + top))) - 1.0, 1e-4) << h;
+        // The sun input stays cos θ0 (the sun's elevation measured worse; docs/neural.md).
+        EXPECT_FLOAT_EQ(in[2], 0.5f);
+    }
+    // The view input is monotonic in cos α0 on each side of the horizon.
+    float last = -2.0f;
+    const float rho = float(std::exp(-1.0 / H));
+    for (int i = 0; i <= 200; ++i) {
+        float in[4];
+        const float cv = -0.0175f + 1.0175f * float(i) / 200.0f; // from just above the horizon (h = 1 km) up
+        encode_inputs(m, cv, 0.0f, 0.5f, rho, in);
+        if (i > 0)
+            EXPECT_LE(in[0], last + 1e-6f) << cv; // up rays: longer towards the horizon
+        last = in[0];
+    }
+}
+
+TEST(NeuralFile, VersionOneFilesLoadAndGiveTheSameOutputs) {
+    // Written and evaluated (`sky eval --model`) by the release before the
+    // encodings became selectable; the CSVs hold its outputs to 9 digits.
+    const std::filesystem::path dir = std::filesystem::path(SKYBAKE_SOURCE_DIR) / "tests/data/neural";
+    auto read = [](const std::filesystem::path& p) {
+        std::ifstream f(p);
+        return std::string(std::istreambuf_iterator<char>(f), {});
+    };
+    const std::vector<SkySample> samples = read_sky_samples_csv(read(dir / "v1_samples.csv"), "v1_samples.csv");
+    for (const char* name : {"v1_paper", "v1_shared_linear"}) {
+        SCOPED_TRACE(name);
+        const NeuralSky net = load_neural_sky(dir / (std::string(name) + ".json"));
+        EXPECT_EQ(net.encoding.inputs, InputEncoding::Seed);
+        EXPECT_EQ(net.encoding.outputs, OutputEncoding::Radiance);
+        std::vector<glm::vec3> got(samples.size());
+        evaluate_neural_sky(net, samples, got);
+        std::ifstream f(dir / (std::string(name) + "_expected.csv"));
+        std::string header;
+        std::getline(f, header);
+        for (std::size_t i = 0; i < samples.size(); ++i) {
+            float r, g, b;
+            char c1, c2;
+            ASSERT_TRUE(f >> r >> c1 >> g >> c2 >> b);
+            EXPECT_EQ(got[i], glm::vec3(r, g, b)) << "sample " << i; // bitwise: 9 digits round-trip a float
+        }
+        // Written again, it is a version 2 file that loads to the same network.
+        const NeuralSky back = neural_sky_from_json(neural_sky_to_json(net));
+        EXPECT_EQ(back.weights, net.weights);
+        EXPECT_EQ(nlohmann::json::parse(neural_sky_to_json(net))["version"], 2);
+    }
+}
+
+TEST(NeuralFile, EncodingsRoundTripAndMismatchesAreErrors) {
+    const NeuralSky net = neural_test::with_encoding(neural_test::random_network("shared:8x6", 3),
+                                                     InputEncoding::Horizon, OutputEncoding::PhaseFactored, 4);
+    ASSERT_EQ(net.topology.outputs, 6); // earth: rayleigh and mie scatter, ozone does not
+    const NeuralSky back = neural_sky_from_json(neural_sky_to_json(net));
+    EXPECT_EQ(back.weights, net.weights);
+    EXPECT_EQ(back.encoding.inputs, InputEncoding::Horizon);
+    ASSERT_EQ(back.encoding.terms.size(), 2u);
+    EXPECT_EQ(back.encoding.terms[1].phase, PhaseFunction::CornetteShanks);
+    EXPECT_EQ(back.encoding.terms[1].max_s, net.encoding.terms[1].max_s);
+    const auto samples = draw_sky_samples(500, 3);
+    for (const SkySample& s : samples)
+        EXPECT_EQ(neural_sky_radiance(back, s), neural_sky_radiance(net, s));
+    nlohmann::json j = nlohmann::json::parse(neural_sky_to_json(net));
+    auto fails = [](const nlohmann::json& bad, const std::string& needle) {
+        try {
+            neural_sky_from_json(bad.dump(), "w.json");
+            ADD_FAILURE() << "accepted: " << needle;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+        }
+    };
+    nlohmann::json bad = j;
+    bad["encoding"]["outputs"] = "radiance"; // 6 outputs in the topology, 4 in the encoding
+    fails(bad, "outputs");
+    bad = j;
+    bad["encoding"]["terms"][0]["max_s"][1] = 1e300;
+    fails(bad, "max_s");
+    bad = j;
+    bad["encoding"]["terms"][0]["phase"] = "none";
+    fails(bad, "phase");
+    bad = j;
+    bad["encoding"]["inputs"] = "sideways";
+    fails(bad, "input encoding");
+    bad = j;
+    bad["encoding"].erase("terms");
+    fails(bad, "terms");
+}
+
+TEST(NeuralPhaseFactored, SplitSumsTimesThePhasesAreTheSky) {
+    // The factorisation the phase-factored outputs rest on: Σ_k P_k(cos β0) S_k
+    // is the table path's radiance, on every sample (to float rounding).
+    SkyModelOptions so;
+    so.tables = {128, 64};
+    so.steps = 16;
+    const SkyModel model(atmosphere_preset("earth"), so);
+    const auto samples = draw_sky_samples(5000, 21);
+    const std::size_t nc = model.atmosphere().components.size();
+    std::vector<glm::vec3> split(samples.size() * nc), sky(samples.size());
+    sky::evaluate_sky_split(model, samples, split);
+    evaluate_sky(model, samples, sky, SkyMethod::Tables);
+    double worst = 0.0;
+    int lit = 0;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+        glm::dvec3 c(0.0);
+        for (std::size_t k = 0; k < nc; ++k) {
+            const AtmosphereComponent& comp = model.atmosphere().components[k];
+            c += phase_function(comp.phase, comp.phase_g, samples[i].cos_view_sun) * glm::dvec3(split[i * nc + k]);
+        }
+        const double ref = glm::length(glm::dvec3(sky[i]));
+        if (ref > 0.0) {
+            ++lit;
+            worst = std::max(worst, glm::length(c - glm::dvec3(sky[i])) / ref);
+        } else {
+            EXPECT_EQ(glm::length(c), 0.0);
+        }
+    }
+    EXPECT_GT(lit, 2000);
+    EXPECT_LT(worst, 2e-6);
+}
+
+namespace {
+
+// Data from a sky built exactly as Σ_k P_k(cos β0) S_k: the S_k are a fixed
+// smooth teacher network (phase-factored, horizon inputs, on earth's
+// Rayleigh and Cornette–Shanks g = 0.8 terms), evaluated on random samples.
+TrainingData teacher_data(const NeuralSky& teacher, OutputEncoding outputs, std::size_t n, std::uint64_t seed) {
+    TrainingData d;
+    const auto samples = draw_sky_samples(n, seed);
+    const MlpHD hd = make_mlp_hd(teacher);
+    d.x = samples_to_matrix(hd, samples);
+    d.radiance.resize(n);
+    MatF enc(hd.outputs, Eigen::Index(n));
+    for (std::size_t i = 0; i < n; ++i) {
+        mlp_forward(hd, d.x.col(Eigen::Index(i)).data(), enc.col(Eigen::Index(i)).data());
+        d.radiance[i] = decode_sky(hd, enc.col(Eigen::Index(i)).data(), samples[i].cos_view_sun);
+    }
+    if (outputs == OutputEncoding::PhaseFactored) {
+        d.t = enc;
+        d.mask.setOnes(enc.rows(), enc.cols());
+    } else {
+        NeuralEncoding e;
+        e.inputs = teacher.encoding.inputs;
+        e.max_n = 0.0;
+        for (const glm::vec3& c : d.radiance)
+            e.max_n = std::max(e.max_n, double(std::max({c.x, c.y, c.z})));
+        encode_targets(e, d.radiance, d.t, d.mask);
+    }
+    d.mask_count = double(d.mask.sum());
+    return d;
+}
+
+} // namespace
+
+TEST(NeuralPhaseFactored, ReproducesASkyBuiltFromTheFactorisation) {
+    // The teacher: small weights, so that its S_k are smooth over the inputs.
+    NeuralSky teacher = neural_test::with_encoding(neural_test::random_network("shared:6", 1), InputEncoding::Horizon,
+                                                   OutputEncoding::PhaseFactored, 11);
+    for (float& w : teacher.weights)
+        w *= 0.5f;
+    const TrainingData train = teacher_data(teacher, OutputEncoding::PhaseFactored, 20000, 1);
+    const TrainingData held = teacher_data(teacher, OutputEncoding::PhaseFactored, 4000, 2);
+    NeuralTrainOptions o;
+    o.samples = train.size();
+    o.adam_epochs = 40;
+    o.batch = 256;
+    o.lm_iterations = 20;
+    o.progress = false;
+    NeuralSky student = teacher;
+    student.topology = parse_topology("shared:8");
+    student.topology.outputs = teacher.topology.outputs;
+    const NeuralSky factored = train_network(student, train, held, o, nullptr, std::chrono::steady_clock::now());
+
+    // The same sky on the seed's radiance outputs: the network has to draw the
+    // aerosol peak and the Rayleigh lobes itself.
+    const TrainingData train_r = teacher_data(teacher, OutputEncoding::Radiance, 20000, 1);
+    const TrainingData held_r = teacher_data(teacher, OutputEncoding::Radiance, 4000, 2);
+    NeuralSky plain = student;
+    plain.encoding = NeuralEncoding{};
+    plain.encoding.inputs = InputEncoding::Horizon;
+    plain.encoding.max_n = 0.0; // as teacher_data encoded it
+    for (const glm::vec3& c : train_r.radiance)
+        plain.encoding.max_n = std::max(plain.encoding.max_n, double(std::max({c.x, c.y, c.z})));
+    plain.topology.outputs = 4;
+    const NeuralSky radiance = train_network(plain, train_r, held_r, o, nullptr, std::chrono::steady_clock::now());
+
+    const double f = factored.training.heldout_mean_relative, r = radiance.training.heldout_mean_relative;
+    std::printf("held-out mean relative error: phase-factored %.3f%%, radiance outputs %.3f%%\n", 100 * f, 100 * r);
+    EXPECT_LT(f, 0.01);
+    EXPECT_LT(f, 0.2 * r);
 }

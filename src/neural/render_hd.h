@@ -8,8 +8,12 @@
 
 namespace skybake::neural {
 
-// sky::shade_ray with the marching sum replaced by the network.
-SKYBAKE_HD_INLINE glm::vec3 shade_ray_neural(const sky::RenderHD& p, const MlpHD& net, const glm::vec3& d) {
+// sky::shade_ray with the marching sum replaced by an approximation of the sky
+// function: sky(cos α0, cos β0, cos θ0, ρ0) -> radiance (the network, or the
+// look-up table it is compared with).
+template <class SkyFunction>
+SKYBAKE_HD_INLINE glm::vec3 shade_ray_approximate(const sky::RenderHD& p, const SkyFunction& neural_sky,
+                                                  const glm::vec3& d) {
     const sky::AtmosphereHD& a = p.atm;
     sky::ObserverHD o{p.eye_r, p.eye_h, d.z, glm::dot(d, p.sun), p.sun.z};
     sky::ObserverHD e = o;
@@ -17,7 +21,7 @@ SKYBAKE_HD_INLINE glm::vec3 shade_ray_neural(const sky::RenderHD& p, const MlpHD
     glm::vec3 c(0.0f);
     if (inside) {
         const float rho = sky::component_density(a.comp[0], e.h);
-        c = neural_sky(net, e.cv, e.cvs, e.cs, rho);
+        c = neural_sky(e.cv, e.cvs, e.cs, rho);
     }
     const float b = p.eye_r * d.z;
     const float disc = b * b - p.eye_h * (2.0f * a.R0 + p.eye_h);
@@ -33,7 +37,7 @@ SKYBAKE_HD_INLINE glm::vec3 shade_ray_neural(const sky::RenderHD& p, const MlpHD
         // network's value there is its smoothing error across the horizon,
         // which the difference removes.
         if (inside)
-            c = glm::max(c - neural_sky(net, glm::dot(n, d), o.cvs, cos_sun, 1.0f), glm::vec3(0.0f));
+            c = glm::max(c - neural_sky(glm::dot(n, d), o.cvs, cos_sun, 1.0f), glm::vec3(0.0f));
         if (cos_sun > 0.0f) {
             glm::vec3 reflected = p.albedo * (cos_sun / sky::kPi) * sky::sun_transmittance(a, a.R0, 0.0f, cos_sun);
             if (p.published_ground) {
@@ -53,6 +57,18 @@ SKYBAKE_HD_INLINE glm::vec3 shade_ray_neural(const sky::RenderHD& p, const MlpHD
         c += t * p.sun_disc_radiance;
     }
     return c * p.irradiance;
+}
+
+// The network's sky.
+struct NetworkSky {
+    const MlpHD& net;
+    SKYBAKE_HD_INLINE glm::vec3 operator()(float cv, float cvs, float cs, float rho) const {
+        return neural_sky(net, cv, cvs, cs, rho);
+    }
+};
+
+SKYBAKE_HD_INLINE glm::vec3 shade_ray_neural(const sky::RenderHD& p, const MlpHD& net, const glm::vec3& d) {
+    return shade_ray_approximate(p, NetworkSky{net}, d);
 }
 
 } // namespace skybake::neural

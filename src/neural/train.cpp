@@ -25,6 +25,7 @@
 #include "skybake/core.h"
 #include "core/random.h"
 #include "skybake/error.h"
+#include "sky/internal.h"
 
 namespace skybake {
 
@@ -34,19 +35,8 @@ namespace {
 
 using SplitMix = SplitMix64;
 
-std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t stream) {
-    SplitMix r{seed ^ (stream * 0xA0761D6478BD642Full)};
-    r.next();
-    return r.next();
-}
 
-// Training or held-out data: inputs, encoded targets, masks, and the reference radiance.
-struct DataSet {
-    MatF x, t, mask;
-    std::vector<glm::vec3> radiance;
-    double mask_count = 0.0;
-    std::size_t size() const { return radiance.size(); }
-};
+using DataSet = TrainingData;
 
 // Training targets from the sky model's table path, on the CPU or the GPU.
 void sky_targets(const SkyModel& model, std::span<const SkySample> s, std::span<glm::vec3> out, Device device) {
@@ -56,17 +46,47 @@ void sky_targets(const SkyModel& model, std::span<const SkySample> s, std::span<
         evaluate_sky(model, s, out, SkyMethod::Tables);
 }
 
-DataSet make_data(const SkyModel& model, const NeuralEncoding& enc, std::size_t n, std::uint64_t seed,
-                  Device device) {
+// The phase-free parts S_k of the table path (n × components) and the radiance Σ_k P_k S_k they make.
+void split_targets(const SkyModel& model, std::span<const SkySample> s, std::vector<glm::vec3>& split,
+                   std::vector<glm::vec3>& radiance) {
+    const Atmosphere& atm = model.atmosphere();
+    const std::size_t nc = atm.components.size();
+    split.resize(s.size() * nc);
+    sky::evaluate_sky_split(model, s, split);
+    radiance.resize(s.size());
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        glm::dvec3 c(0.0);
+        for (std::size_t k = 0; k < nc; ++k)
+            c += phase_function(atm.components[k].phase, atm.components[k].phase_g, double(s[i].cos_view_sun)) *
+                 glm::dvec3(split[i * nc + k]);
+        radiance[i] = glm::vec3(c);
+    }
+}
+
+} // namespace
+
+TrainingData neural::make_training_data(const SkyModel& model, const NeuralEncoding& enc, std::size_t n,
+                                        std::uint64_t seed, Device device) {
     DataSet d;
     const std::vector<SkySample> s = draw_sky_samples(n, seed);
-    d.radiance.resize(n);
-    sky_targets(model, s, d.radiance, device);
-    d.x = samples_to_matrix(s);
-    encode_targets(enc, d.radiance, d.t, d.mask);
+    MlpHD hd;
+    set_encoding_hd(enc, model.atmosphere(), hd);
+    d.x = samples_to_matrix(hd, s);
+    if (enc.outputs == OutputEncoding::PhaseFactored) {
+        std::vector<glm::vec3> split;
+        split_targets(model, s, split, d.radiance);
+        encode_split_targets(enc, split, model.atmosphere().components.size(),
+                             phase_term_components(model.atmosphere()), d.t, d.mask);
+    } else {
+        d.radiance.resize(n);
+        sky_targets(model, s, d.radiance, device);
+        encode_targets(enc, d.radiance, d.t, d.mask);
+    }
     d.mask_count = double(d.mask.sum());
     return d;
 }
+
+namespace {
 
 // Xavier/Glorot uniform initialisation scaled for the activation's slope at 0
 // (kSlope/4 instead of the logistic's 1/4); biases 0.
@@ -101,7 +121,7 @@ ErrorPair evaluate_set(const Layout& lay, const NeuralSky& net, const DataSet& d
         d.size(), 2048, Part{},
         [&](std::size_t lo, std::size_t hi) {
             Part part;
-            MatF enc(4, Eigen::Index(hi - lo));
+            MatF enc(hd.outputs, Eigen::Index(hi - lo));
             forward_network(lay, net.weights.data(), d.x.middleCols(Eigen::Index(lo), Eigen::Index(hi - lo)), enc,
                             tls_workspace);
             const MatF diff = ((enc - d.t.middleCols(Eigen::Index(lo), Eigen::Index(hi - lo))).array() *
@@ -113,7 +133,8 @@ ErrorPair evaluate_set(const Layout& lay, const NeuralSky& net, const DataSet& d
                 const float n = std::max({ref.x, ref.y, ref.z});
                 if (!(n > 0.0f))
                     continue;
-                const glm::vec3 got = decode_sky(hd, enc.col(Eigen::Index(i - lo)).data());
+                // Row 1 of the inputs is cos β0 in every input encoding.
+                const glm::vec3 got = decode_sky(hd, enc.col(Eigen::Index(i - lo)).data(), d.x(1, Eigen::Index(i)));
                 const glm::dvec3 e = glm::dvec3(got) - glm::dvec3(ref);
                 part.rel += std::sqrt(e.x * e.x + e.y * e.y + e.z * e.z) /
                             std::sqrt(double(ref.x) * ref.x + double(ref.y) * ref.y + double(ref.z) * ref.z);
@@ -145,7 +166,7 @@ GradPart batch_gradient(const Layout& lay, const std::vector<float>& w, const Da
         [&](std::size_t b, std::size_t e) {
             GradPart part{0.0, std::vector<double>(P, 0.0)};
             const Eigen::Index n = Eigen::Index(e - b);
-            MatF x(4, n), t(4, n), m(4, n);
+            MatF x(4, n), t(d.t.rows(), n), m(d.t.rows(), n);
             for (Eigen::Index j = 0; j < n; ++j) {
                 const Eigen::Index c = Eigen::Index(idx[lo + b + std::size_t(j)]);
                 x.col(j) = d.x.col(c);
@@ -219,6 +240,65 @@ NormalPart normal_equations(const Layout& lay, const std::vector<float>& w, int 
 
 } // namespace
 
+std::uint64_t neural::stream_seed(std::uint64_t seed, std::uint64_t stream) {
+    SplitMix64 r{seed ^ (stream * 0xA0761D6478BD642Full)};
+    r.next();
+    return r.next();
+}
+
+NeuralEncoding neural::make_training_encoding(const SkyModel& model, const NeuralTrainOptions& o) {
+    if ((o.brightness == BrightnessEncoding::Log || o.outputs == OutputEncoding::PhaseFactored) &&
+        !(o.log_range > 0.0 && o.log_range < 200.0))
+        throw Error("the log range must be in (0, 200) nats", "log_range");
+    const std::vector<int> term_components = phase_term_components(model.atmosphere());
+    if (o.outputs == OutputEncoding::PhaseFactored) {
+        if (model.atmosphere().scattering != Scattering::Single)
+            throw Error("phase-factored outputs are exact for single scattering only; use outputs radiance for an "
+                        "atmosphere with multiple scattering",
+                        "outputs");
+        if (o.brightness != BrightnessEncoding::Log)
+            throw Error("phase-factored outputs are log-encoded; the linear brightness is for radiance outputs",
+                        "brightness");
+        if (term_components.empty() || term_components.size() > std::size_t(kMaxTerms))
+            throw Error("phase-factored outputs need 1 to 4 scattering components in the atmosphere", "outputs");
+    }
+
+    NeuralEncoding encoding;
+    encoding.inputs = o.inputs;
+    encoding.outputs = o.outputs;
+    encoding.brightness = o.brightness;
+    encoding.log_range = o.log_range;
+    {   // max{N} (and max S_k per channel) over random samples (the seed's 100,000)
+        const std::vector<SkySample> s = draw_sky_samples(o.max_n_samples, stream_seed(o.seed, 2));
+        std::vector<glm::vec3> r, split;
+        if (o.outputs == OutputEncoding::PhaseFactored) {
+            split_targets(model, s, split, r);
+            const std::size_t nc = model.atmosphere().components.size();
+            for (int k : term_components) {
+                const AtmosphereComponent& c = model.atmosphere().components[std::size_t(k)];
+                PhaseTerm t{c.name, c.phase, c.phase_g, glm::dvec3(0.0)};
+                for (std::size_t i = 0; i < s.size(); ++i)
+                    t.max_s = glm::max(t.max_s, glm::dvec3(split[i * nc + std::size_t(k)]));
+                for (int ch = 0; ch < 3; ++ch)
+                    if (!(t.max_s[ch] > 0.0))
+                        t.max_s[ch] = 1e-30; // a channel this component never scatters: decoded as (almost) 0
+                encoding.terms.push_back(t);
+            }
+        } else {
+            r.resize(s.size());
+            sky_targets(model, s, r, o.device);
+        }
+        double mx = 0.0;
+        for (const glm::vec3& c : r)
+            mx = std::max(mx, double(std::max({c.x, c.y, c.z})));
+        if (!(mx > 0.0))
+            throw Error("the sky is black on every sample; check the atmosphere's scattering coefficients",
+                        "atmosphere");
+        encoding.max_n = mx;
+    }
+    return encoding;
+}
+
 NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, std::vector<LearningCurvePoint>* curve) {
     o.topology.validate("topology");
     if (o.samples < 16 || o.samples > (std::size_t(1) << 31))
@@ -231,33 +311,25 @@ NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, s
         throw Error("the mini-batch must hold 1 to `samples` samples", "batch");
     if (!(o.learning_rate > 0.0 && o.learning_rate_final > 0.0 && o.learning_rate < 10.0))
         throw Error("learning rates must be positive (and below 10)", "learning_rate");
-    if (o.brightness == BrightnessEncoding::Log && !(o.log_range > 0.0 && o.log_range < 200.0))
+    if ((o.brightness == BrightnessEncoding::Log || o.outputs == OutputEncoding::PhaseFactored) &&
+        !(o.log_range > 0.0 && o.log_range < 200.0))
         throw Error("the log range must be in (0, 200) nats", "log_range");
-
     const auto t0 = std::chrono::steady_clock::now();
-    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
-
     NeuralSky net;
     net.topology = o.topology;
     net.atmosphere = model.atmosphere();
     net.sky_options = model.options();
-    net.encoding.brightness = o.brightness;
-    net.encoding.log_range = o.log_range;
-    {   // max{N} over random samples (the seed's 100,000)
-        const std::vector<SkySample> s = draw_sky_samples(o.max_n_samples, stream_seed(o.seed, 2));
-        std::vector<glm::vec3> r(s.size());
-        sky_targets(model, s, r, o.device);
-        double mx = 0.0;
-        for (const glm::vec3& c : r)
-            mx = std::max(mx, double(std::max({c.x, c.y, c.z})));
-        if (!(mx > 0.0))
-            throw Error("the sky is black on every sample; check the atmosphere's scattering coefficients",
-                        "atmosphere");
-        net.encoding.max_n = mx;
-    }
-    const DataSet train = make_data(model, net.encoding, o.samples, stream_seed(o.seed, 0), o.device);
-    const DataSet held = make_data(model, net.encoding, o.heldout_samples, stream_seed(o.seed, 1), o.device);
+    net.encoding = make_training_encoding(model, o);
+    net.topology.outputs = net.encoding.output_count();
+    const DataSet train = make_training_data(model, net.encoding, o.samples, stream_seed(o.seed, 0), o.device);
+    const DataSet held = make_training_data(model, net.encoding, o.heldout_samples, stream_seed(o.seed, 1), o.device);
+    return train_network(std::move(net), train, held, o, curve, t0);
+}
 
+NeuralSky neural::train_network(NeuralSky net, const TrainingData& train, const TrainingData& held,
+                                const NeuralTrainOptions& o, std::vector<LearningCurvePoint>* curve,
+                                std::chrono::steady_clock::time_point t0) {
+    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
     const Layout lay = make_layout(net.topology);
     net.weights = initial_weights(lay, stream_seed(o.seed, 3));
     const std::size_t P = net.weights.size();

@@ -40,6 +40,11 @@ PhaseFunction parse_phase(const std::string& s, const std::string& where) {
 
 } // namespace
 
+const char* phase_function_name(PhaseFunction phase) { return phase_name(phase); }
+PhaseFunction parse_phase_function(const std::string& text, const std::string& where) {
+    return parse_phase(text, where);
+}
+
 namespace {
 constexpr NamedValue<TableRule> kTableRuleNames[] = {
     {TableRule::AsPublished, "as-published", "the paper's density at the shell boundary", "seed"},

@@ -23,6 +23,11 @@ ObserverHD make_observer(const Atmosphere& atmosphere, double radius_km, double 
 // Observer state from a sky sample (ρ0 -> altitude of the first component).
 ObserverHD make_observer(const Atmosphere& atmosphere, const SkySample& sample);
 
+// The model's single-scattering table path split by component without the
+// phase functions (seed_sky_sum_split), over all cores:
+// out[i * components + k] for sample i and component k.
+void evaluate_sky_split(const SkyModel& model, std::span<const SkySample> samples, std::span<glm::vec3> out);
+
 // Exact in-scattered radiance (1/sr, per unit irradiance) along the segment
 // from `origin_km` in unit direction `dir` for length_km, with unit sun
 // direction `sun`, all in a planet-centred frame. Also returns the segment's

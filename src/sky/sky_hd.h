@@ -338,6 +338,61 @@ SKYBAKE_HD_INLINE glm::vec3 seed_sky_sum(const AtmosphereHD& a, ObserverHD o, in
     return result;
 }
 
+// The single-scattering sum split by component and without the phase
+// functions: out[k] = Σ b_k ρ_k T Δv, so that seed_sky_sum = Σ_k P_k(cos β0)
+// out[k] (to rounding). With a parallel sun, cos β is the same at every point
+// of the view ray, which is what lets a network learn the phase-free parts
+// and apply the exact phase functions outside (docs/neural.md).
+struct SplitPoint {
+    const AtmosphereHD& a;
+    const ObserverHD& o;
+    const SumState& st;
+    glm::vec3* out;
+    SKYBAKE_HD_INLINE void operator()(float v, float dv) const {
+        float d2 = st.base + v * (v + 2.0f * o.r * o.cv);
+        d2 = d2 > 0.0f ? d2 : 0.0f;
+        const float rv = sqrtf(a.R0 * a.R0 + d2);
+        const float hv = d2 / (rv + a.R0);
+        const StepCosines c_v = step_cosines(o, v, 1.0f / rv);
+        if (in_planet_shadow(rv, c_v.sun_zenith, a.R0))
+            return;
+        glm::vec3 tau(0.0f), weight[kMaxComponents];
+        for (int k = 0; k < a.count; ++k) {
+            const ComponentHD& c = a.comp[k];
+            const float rho = component_density(c, hv);
+            const float u = table_coordinate(a, c, hv, rho);
+            const float t = st.l_obs[k] - optical_length_lookup(a, c, rv, u, c_v.view_zenith) +
+                            optical_length_lookup(a, c, rv, u, c_v.sun_zenith);
+            tau += c.ext * t;
+            weight[k] = c.sca * rho;
+        }
+        const glm::vec3 T = dv * glm::vec3(expf(-tau.x), expf(-tau.y), expf(-tau.z));
+        for (int k = 0; k < a.count; ++k)
+            out[k] += weight[k] * T;
+    }
+};
+
+SKYBAKE_HD_INLINE void seed_sky_sum_split(const AtmosphereHD& a, ObserverHD o, int steps, int spacing,
+                                          glm::vec3 out[kMaxComponents]) {
+    for (int k = 0; k < kMaxComponents; ++k)
+        out[k] = glm::vec3(0.0f);
+    if (!enter_atmosphere(a, o))
+        return;
+    const float ground = distance_to_ground(o.r, o.cv, a.R0);
+    const float length = ground >= 0.0f ? ground : distance_to_sphere_exit(o.r, o.cv, a.Rtop);
+    if (length <= 0.0f || steps <= 0)
+        return;
+    SumState st;
+    for (int k = 0; k < a.count; ++k) {
+        const ComponentHD& c = a.comp[k];
+        st.scatter[k] = c.sca;
+        const float rho = component_density(c, o.h);
+        st.l_obs[k] = optical_length_lookup(a, c, o.r, table_coordinate(a, c, o.h, rho), o.cv);
+    }
+    st.base = o.h * (2.0f * a.R0 + o.h);
+    march_view_ray(a, o, st.base, length, steps, spacing, SplitPoint{a, o, st, out});
+}
+
 // Transmittance along a ray segment from a point A to a point B on the same
 // line, A nearer the observer, from the tables: exp(−Σ b_k (L_k[A] − L_k[B])),
 // both lookups in the view direction (cosines ca, cb to the local verticals).

@@ -192,6 +192,23 @@ void evaluate_sky(const SkyModel& model, std::span<const SkySample> samples, std
     });
 }
 
+void sky::evaluate_sky_split(const SkyModel& model, std::span<const SkySample> samples, std::span<glm::vec3> out) {
+    const sky::AtmosphereHD& hd = sky::atmosphere_hd(model);
+    const Atmosphere& atm = model.atmosphere();
+    const std::size_t n = atm.components.size();
+    assert(out.size() == samples.size() * n);
+    const int steps = model.options().steps;
+    const int spacing = model.options().uniform_steps ? sky::kStepsUniform : sky::kStepsGraded;
+    parallel_for(samples.size(), 1024, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+            glm::vec3 parts[sky::kMaxComponents];
+            sky::seed_sky_sum_split(hd, sky::make_observer(atm, samples[i]), steps, spacing, parts);
+            for (std::size_t k = 0; k < n; ++k)
+                out[i * n + k] = parts[k];
+        }
+    });
+}
+
 void evaluate_sky(const Atmosphere& atmosphere, std::span<const SkySample> samples, std::span<glm::vec3> out,
                   SkyMethod method) {
     const SkyModel model(atmosphere);
