@@ -233,8 +233,8 @@ struct NeuralTrainOptions {
     std::size_t batch = 1024;                // Adam mini-batch
     double learning_rate = 0.02;             // Adam, first epoch
     double learning_rate_final = 0.0005;     // Adam, last epoch (exponential decay between)
-    int lm_iterations = 30;                  // Levenberg–Marquardt iterations; 0 skips it
-    std::size_t lm_samples = 0;              // rows of the LM least squares; 0: automatic
+    int lm_iterations = 20;                  // Levenberg–Marquardt iterations; 0 skips it
+    std::size_t lm_samples = 0;              // samples in the LM least squares; 0: automatic (train.cpp)
     bool progress = true;                    // progress bar on stderr (TTY only)
     // Where the training targets are computed: Device::Cuda runs the sky
     // model's table path on the GPU (evaluate_sky_cuda); the optimiser runs

@@ -135,6 +135,8 @@ def save_atmosphere(path: Path, atmosphere: Atmosphere) -> None: ...
 class NeuralSky:
     topology: str
     weight_count: int
+    inputs: str
+    outputs: str
     weights: F32
     atmosphere: Atmosphere
     training: dict[str, float]
@@ -179,10 +181,12 @@ class Sky:
 def draw_sky_samples(count: int, seed: int = 1) -> F32: ...
 def train_sky(
     atmosphere: Atmosphere,
-    topology: str = "paper",
+    topology: str = "shared:16x12",
+    inputs: str = "horizon",
+    outputs: Optional[str] = None,
     samples: int = 800000,
     adam_epochs: int = 60,
-    lm_iterations: int = 30,
+    lm_iterations: int = 20,
     seed: int = 1,
     brightness: str = "log",
     table_rule: str = "refined",

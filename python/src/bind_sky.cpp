@@ -96,6 +96,12 @@ void bind_sky(py::module_& m) {
         .def_property_readonly("topology", [](const NeuralSky& n) { return n.topology.name(); })
         .def_property_readonly("weight_count", [](const NeuralSky& n) { return n.topology.weight_count(); })
         .def_property_readonly(
+            "inputs", [](const NeuralSky& n) { return std::string(input_encoding_name(n.encoding.inputs)); },
+            "Input encoding: 'seed' or 'horizon'.")
+        .def_property_readonly(
+            "outputs", [](const NeuralSky& n) { return std::string(output_encoding_name(n.encoding.outputs)); },
+            "Output encoding: 'radiance' or 'phase-factored'.")
+        .def_property_readonly(
             "weights",
             [](const NeuralSky& n) {
                 std::vector<float> w = n.weights;
@@ -216,9 +222,10 @@ void bind_sky(py::module_& m) {
 
     m.def(
         "train_sky",
-        [](Atmosphere atmosphere, const std::string& topology, std::size_t samples, int adam_epochs,
-           int lm_iterations, std::uint64_t seed, const std::string& brightness, const std::string& table_rule,
-           int steps, const std::string& device, py::object progress) {
+        [](Atmosphere atmosphere, const std::string& topology, const std::string& inputs,
+           std::optional<std::string> outputs, std::size_t samples, int adam_epochs, int lm_iterations,
+           std::uint64_t seed, const std::string& brightness, const std::string& table_rule, int steps,
+           const std::string& device, py::object progress) {
             atmosphere.table_rule = parse_table_rule(table_rule, "table_rule");
             atmosphere.validate();
             if (steps < 1 || steps > 4096)
@@ -231,6 +238,12 @@ void bind_sky(py::module_& m) {
             o.lm_iterations = lm_iterations;
             o.seed = seed;
             o.brightness = parse_brightness_encoding(brightness, "brightness");
+            o.inputs = parse_input_encoding(inputs, "inputs");
+            // As `sky train`: phase-factored outputs unless the sky has multiple
+            // scattering, for which they are not exact (train_neural_sky refuses them).
+            o.outputs = outputs ? parse_output_encoding(*outputs, "outputs")
+                                : atmosphere.scattering == Scattering::Single ? OutputEncoding::PhaseFactored
+                                                                              : OutputEncoding::Radiance;
             o.device = parse_device(device);
             o.progress = true; // events go to the call's callback, never to a bar
             if (samples < 1000)
@@ -245,13 +258,16 @@ void bind_sky(py::module_& m) {
                 return train_neural_sky(model, o);
             });
         },
-        py::arg("atmosphere"), py::arg("topology") = "paper", py::arg("samples") = 800000,
-        py::arg("adam_epochs") = 60, py::arg("lm_iterations") = 30, py::arg("seed") = 1,
+        py::arg("atmosphere"), py::arg("topology") = kDefaultTopology, py::arg("inputs") = "horizon",
+        py::arg("outputs") = py::none(), py::arg("samples") = 800000,
+        py::arg("adam_epochs") = 60, py::arg("lm_iterations") = 20, py::arg("seed") = 1,
         py::arg("brightness") = "log", py::arg("table_rule") = "refined", py::arg("steps") = kTrainingTargetSteps,
         py::arg("device") = "cpu", py::arg("progress") = py::none(),
         "Trains a network on the table path of `atmosphere` (Adam, then Levenberg–Marquardt), as "
-        "`skybake sky train`: targets from the refined 512 x 256 tables with 64 steps by default (table_rule="
-        "'as-published', steps=16, brightness='linear' for the seed's setting). Deterministic for a seed. "
+        "`skybake sky train`: by default the best small network (shared:16x12, horizon inputs, phase-factored "
+        "outputs; radiance outputs with multiple scattering), targets from the refined 512 x 256 tables with 64 "
+        "steps. The seed's network: topology='paper', inputs='seed', outputs='radiance', brightness='linear' "
+        "(and table_rule='as-published', steps=16 for its targets). Deterministic for a seed. "
         "topology: 'paper' (324 weights), 'independent:16x16', 'shared:64x64', ...");
 }
 

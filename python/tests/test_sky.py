@@ -12,7 +12,9 @@ def earth():
 
 @pytest.fixture(scope="module")
 def tiny_net(earth):
-    return skybake.train_sky(earth, topology="paper", samples=4000, adam_epochs=2, lm_iterations=1, seed=5)
+    # The seed's network exactly: its topology, inputs and outputs.
+    return skybake.train_sky(earth, topology="paper", inputs="seed", outputs="radiance", brightness="linear",
+                             samples=4000, adam_epochs=2, lm_iterations=1, seed=5)
 
 
 def test_tables_agree_with_the_exact_quadrature(earth):
@@ -75,11 +77,19 @@ def test_network_round_trip(tiny_net, tmp):
 
 
 def test_training_is_deterministic(earth, tiny_net):
-    again = skybake.train_sky(earth, topology="paper", samples=4000, adam_epochs=2, lm_iterations=1, seed=5)
+    again = skybake.train_sky(earth, topology="paper", inputs="seed", outputs="radiance", brightness="linear",
+                              samples=4000, adam_epochs=2, lm_iterations=1, seed=5)
     np.testing.assert_array_equal(again.weights, tiny_net.weights)
+    assert (tiny_net.inputs, tiny_net.outputs) == ("seed", "radiance")
     events = []
-    skybake.train_sky(earth, samples=2000, adam_epochs=1, lm_iterations=0, progress=events.append)
+    default = skybake.train_sky(earth, samples=2000, adam_epochs=1, lm_iterations=0, progress=events.append)
     assert events and events[-1].finished
+    # The default: the best small network, horizon inputs and phase-factored
+    # outputs (Rayleigh and Mie, three channels each).
+    assert (default.topology, default.inputs, default.outputs) == ("shared:16x12", "horizon", "phase-factored")
+    assert default.weight_count == (4 + 1) * 16 + (16 + 1) * 12 + (12 + 1) * 6
+    with pytest.raises(skybake.Error, match="outputs"):
+        skybake.train_sky(earth, outputs="spectral", samples=2000, adam_epochs=1, lm_iterations=0)
 
 
 def test_atmosphere_json_round_trip(earth):

@@ -66,14 +66,13 @@ inline NeuralSky with_encoding(NeuralSky net, InputEncoding inputs, OutputEncodi
 //   e = |f'|max · sqrt(Σ_c w_c² e_c² + (n + 1) u² (Σ_c w_c² + b²)) + 4u,
 // |f'|max = ln 2 / 2 (f(x) = σ(−2 ln 2 · x)), u = 2⁻²⁴, and 4u for the
 // activation's own error (ex2.approx 2 ulp, rcp.approx 1 ulp). Returns the
-// model for each of the four encoded outputs; check_modelled_bound allows
-// kSigmas times it.
+// model for each encoded output; check_modelled_bound allows kSigmas times it.
 constexpr double kSigmas = 8.0;
 
-inline std::array<double, 4> encoded_error_bound(const NeuralSky& net) {
+inline std::vector<double> encoded_error_bound(const NeuralSky& net) {
     const neural::MlpHD m = neural::make_mlp_hd(net);
     const double u = std::ldexp(1.0, -24), slope = std::log(2.0) / 2.0;
-    std::array<double, 4> bound{};
+    std::vector<double> bound(std::size_t(net.encoding.output_count()), 0.0);
     for (int sub = 0; sub < m.subnets; ++sub) {
         const float* w = net.weights.data() + std::size_t(sub) * std::size_t(m.subnet_params);
         std::vector<double> e(std::size_t(m.width[0]), 0.0);
@@ -108,7 +107,11 @@ inline std::array<double, 4> encoded_error_bound(const NeuralSky& net) {
 // scalar passes use 3% of it, and a GPU's difference is estimated at
 // 3.5–4e-5. Samples whose brightness output is within e_M of the
 // night threshold (0.05) may decode as night on one side only and are left
-// out; at least a tenth of the samples must be lit.
+// out; at least a tenth of the samples must be lit. Phase-factored outputs:
+// every channel of every S_k is log-encoded, a sum of positive terms is off
+// by at most its worst term's relative error, log_range · e_k / 0.9 (+ the
+// decoder's exp and the phase function's float rounding), and samples with
+// any code within e_k of 0.05 are left out.
 struct BoundCheck {
     std::size_t lit = 0, outside = 0; // compared samples, and those outside their bound
     double worst_error = 0.0, worst_fraction = 0.0;
@@ -116,21 +119,33 @@ struct BoundCheck {
 
 inline BoundCheck check_modelled_bound(const NeuralSky& net, const std::vector<SkySample>& samples,
                                        const std::vector<glm::vec3>& cpu, const std::vector<glm::vec3>& gpu) {
-    const std::array<double, 4> e = encoded_error_bound(net);
-    const double e_c = std::max({e[0], e[1], e[2]});
+    const std::vector<double> e = encoded_error_bound(net);
+    const bool factored = net.encoding.outputs == OutputEncoding::PhaseFactored;
+    const double e_c = factored ? 0.0 : std::max({e[0], e[1], e[2]});
+    const double e_max = *std::max_element(e.begin(), e.end());
     BoundCheck r;
     for (std::size_t i = 0; i < cpu.size(); ++i) {
-        float enc[4];
+        float enc[neural::kMaxOutputs];
         neural_sky_encoded(net, samples[i], enc);
-        if (std::abs(double(enc[3]) - 0.05) <= e[3] || std::max({cpu[i].x, cpu[i].y, cpu[i].z}) <= 0.0f)
+        if (std::max({cpu[i].x, cpu[i].y, cpu[i].z}) <= 0.0f)
+            continue;
+        bool near_threshold = false;
+        for (std::size_t k = factored ? 0 : 3; k < e.size(); ++k)
+            near_threshold |= std::abs(double(enc[k]) - 0.05) <= e[k];
+        if (near_threshold)
             continue;
         ++r.lit;
-        const double m = (double(enc[3]) - 0.05) / 0.9;
-        const double c_max = std::max({enc[0], enc[1], enc[2]}) - 0.05;
-        const double dn = net.encoding.brightness == BrightnessEncoding::Log
-                              ? std::expm1(net.encoding.log_range * e[3] / 0.9) + 1e-6 // + the decoder's exp
-                              : e[3] / (0.9 * m);
-        const double bound = kSigmas * (e_c / std::max(0.9 * c_max, 1e-30) + dn);
+        double bound;
+        if (factored) {
+            bound = kSigmas * (std::expm1(net.encoding.log_range * e_max / 0.9) + 1e-6) + 1e-6;
+        } else {
+            const double m = (double(enc[3]) - 0.05) / 0.9;
+            const double c_max = std::max({enc[0], enc[1], enc[2]}) - 0.05;
+            const double dn = net.encoding.brightness == BrightnessEncoding::Log
+                                  ? std::expm1(net.encoding.log_range * e[3] / 0.9) + 1e-6 // + the decoder's exp
+                                  : e[3] / (0.9 * m);
+            bound = kSigmas * (e_c / std::max(0.9 * c_max, 1e-30) + dn);
+        }
         const double ref = std::max({cpu[i].x, cpu[i].y, cpu[i].z});
         double err = 0.0;
         for (int c = 0; c < 3; ++c)

@@ -117,8 +117,9 @@ void emit_horizon_inputs(std::ostringstream& o, const MlpHD& m, const Dialect& d
     const std::string one = lit(1.0f, d), zero = lit(0.0f, d), two = lit(2.0f, d);
     const std::string sqrt_ = d.shader ? "sqrt" : "sqrtf", log_ = d.shader ? "log" : "logf";
     const std::string abs_ = d.shader ? "abs" : "fabsf";
-    auto clamp01 = [&](const std::string& x) {
-        return fmt::format("({0} > {1} ? ({0} < {2} ? {0} : {2}) : {1})", x, zero, one);
+    const std::string gap = lit(kHorizonGap, d), span = lit(kHorizonSpan, d);
+    auto view_input = [&](const std::string& x) { // g + (1 − g) clamp(x, 0, 1)
+        return fmt::format("({3} + {4} * ({0} > {1} ? ({0} < {2} ? {0} : {2}) : {1}))", x, zero, one, gap, span);
     };
     o << "    // horizon inputs: ray length split at the horizon, cos b0, cos t0, altitude coordinate\n";
     o << fmt::format("    float h = -{} * {}(density);\n", scale, log_);
@@ -133,13 +134,13 @@ void emit_horizon_inputs(std::ostringstream& o, const MlpHD& m, const Dialect& d
     o << fmt::format("        float dd = -rc - {}(disc > {} ? disc : {});\n", sqrt_, zero, zero);
     o << "        float span = rho - h;\n";
     o << fmt::format("        float t = span > {} ? (dd - h) / span : {};\n", zero, zero);
-    o << fmt::format("        in0 = -{};\n", clamp01("t"));
+    o << fmt::format("        in0 = -{};\n", view_input("t"));
     o << "    } else {\n";
     o << fmt::format("        float disc = rc * rc + ({} - h) * ({} * {} + {} + h);\n", top, two, R0, top);
     o << fmt::format("        float dd = -rc + {}(disc > {} ? disc : {});\n", sqrt_, zero, zero);
     o << fmt::format("        float span = rho + {} - ({} - h);\n", H, top);
     o << fmt::format("        float t = span > {} ? (dd - ({} - h)) / span : {};\n", zero, top, zero);
-    o << fmt::format("        in0 = {};\n", clamp01("t"));
+    o << fmt::format("        in0 = {};\n", view_input("t"));
     o << "    }\n";
     o << "    float in1 = cos_view_sun, in2 = cos_sun_zenith;\n";
     o << fmt::format("    float in3 = {} * rho / {} - {};\n", two, H, one);

@@ -3,6 +3,7 @@
 // (Bruneton & Neyret 2008, Bruneton 2017 store the sky this way), fitted by
 // linear least squares to the same targets the network learns.
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
 
@@ -124,12 +125,29 @@ SkyLookupTable fit_sky_lookup_table(const SkyModel& model, const NeuralTrainOpti
         for (std::size_t i = b; i < e; ++i)
             k[i] = corners(t, d.x.col(Eigen::Index(i)).data());
     });
+    // A node's neighbours in the normal matrix lie within ±1 node along every
+    // input: 3⁴ = 81 of them, accumulated per node by offset code
+    // Σ (d_a + 1) 3^a, then handed to Eigen once.
+    std::array<int, 4> stride{};
+    for (int a = 0, s = 1; a < 4; ++a) {
+        stride[std::size_t(a)] = s;
+        s *= t.size[std::size_t(a)];
+    }
+    int code[16][16];
+    for (int a = 0; a < 16; ++a)
+        for (int b = 0; b < 16; ++b) {
+            code[a][b] = 0;
+            for (int axis = 0, p = 1; axis < 4; ++axis, p *= 3)
+                code[a][b] += (((b >> axis) & 1) - ((a >> axis) & 1) + 1) * p;
+        }
+    std::vector<double> band;
     for (int out = 0; out < outputs; ++out) {
         int same = -1; // an earlier output with the same mask row
         for (int p = 0; p < out && same < 0; ++p)
             if (d.mask.row(p) == d.mask.row(out))
                 same = p;
-        std::vector<Eigen::Triplet<double>> entries;
+        if (same < 0)
+            band.assign(std::size_t(nodes) * 81, 0.0);
         Eigen::VectorXd rhs = Eigen::VectorXd::Zero(nodes);
         for (std::size_t i = 0; i < d.size(); ++i) {
             const double w = d.mask(out, Eigen::Index(i));
@@ -137,18 +155,35 @@ SkyLookupTable fit_sky_lookup_table(const SkyModel& model, const NeuralTrainOpti
                 continue;
             const double target = d.t(out, Eigen::Index(i));
             for (int a = 0; a < 16; ++a) {
-                rhs(k[i].node[a]) += w * k[i].weight[a] * target;
-                if (same < 0)
+                const double wa = w * double(k[i].weight[a]);
+                rhs(k[i].node[a]) += wa * target;
+                if (same < 0) {
+                    double* row = &band[std::size_t(k[i].node[a]) * 81];
                     for (int b = 0; b < 16; ++b)
-                        entries.emplace_back(k[i].node[a], k[i].node[b],
-                                             w * double(k[i].weight[a]) * double(k[i].weight[b]));
+                        row[code[a][b]] += wa * double(k[i].weight[b]);
+                }
             }
         }
         static thread_local Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver;
         if (same < 0) {
+            std::vector<Eigen::Triplet<double>> entries;
+            entries.reserve(std::size_t(nodes) * 81);
+            double diagonal = 0.0;
+            for (int j = 0; j < nodes; ++j)
+                for (int c = 0; c < 81; ++c) {
+                    const double v = band[std::size_t(j) * 81 + std::size_t(c)];
+                    if (v == 0.0)
+                        continue;
+                    int other = j;
+                    for (int axis = 0, q = c; axis < 4; ++axis, q /= 3)
+                        other += (q % 3 - 1) * stride[std::size_t(axis)];
+                    entries.emplace_back(j, other, v);
+                    if (c == 40)
+                        diagonal += v;
+                }
             Eigen::SparseMatrix<double> A(nodes, nodes);
             A.setFromTriplets(entries.begin(), entries.end());
-            const double ridge = 1e-6 * std::max(1e-30, A.diagonal().mean());
+            const double ridge = 1e-6 * std::max(1e-30, diagonal / double(nodes));
             for (int j = 0; j < nodes; ++j)
                 A.coeffRef(j, j) += ridge;
             solver.compute(A);

@@ -91,16 +91,21 @@ SKYBAKE_HD_INLINE void mlp_forward(const MlpHD& m, const float in[kInputs], floa
         mlp_subnet_forward(m, m.weights + s * m.subnet_params, in, enc + s);
 }
 
+constexpr float kHorizonGap = 0.25f, kHorizonSpan = 1.0f - kHorizonGap;
+
 // The network's inputs from the sky function's arguments.
 //  seed:    (cos α0, cos β0, cos θ0, ρ0) as they are.
 //  horizon: altitude h = −H ln ρ0 (H: scale height of the first component),
 //           r = R0 + h, ρ = √(r² − R0²), Ĥ = √(Rtop² − R0²); then
 //   in0: the view ray's length d to where it leaves the atmosphere or meets
-//        the ground, as in Bruneton 2017's texture mapping: up rays
-//        (d − dmin)/(dmax − dmin) in [0, 1] with dmin = Rtop − r, dmax = ρ + Ĥ;
-//        ground rays −(d − dmin)/(dmax − dmin) in [−1, 0] with dmin = h,
-//        dmax = ρ. The horizon seen from above is +1, from below −1: the
-//        cliff between them is as far apart as the input allows.
+//        the ground, as in Bruneton 2017's texture mapping, t = (d − dmin)/
+//        (dmax − dmin): up rays (dmin = Rtop − r, dmax = ρ + Ĥ) map to
+//        g + (1 − g) t in [g, 1], ground rays (dmin = h, dmax = ρ) to
+//        −(g + (1 − g) t) in [−1, −g], g = kHorizonGap. The horizon seen
+//        from above is +1, from below −1: the cliff between them is as far
+//        apart as the input allows. The zenith (g) and the nadir (−g), where
+//        the two halves meet, are 2g apart, room for the network to go from
+//        the bright zenith to the dark short rays below.
 //   in1: cos β0.
 //   in2: cos θ0. (The sun's elevation above the observer's dipped horizon,
 //        (asin cos θ0 + atan(ρ/R0)) / (π/2), was tried and measured worse:
@@ -128,13 +133,13 @@ SKYBAKE_HD_INLINE void encode_inputs(const MlpHD& m, float cos_view_zenith, floa
         const float d = -rc - sqrtf(disc > 0.0f ? disc : 0.0f);
         const float span = rho - h;
         const float t = span > 0.0f ? (d - h) / span : 0.0f;
-        in[0] = -(t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f);
+        in[0] = -(kHorizonGap + kHorizonSpan * (t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f));
     } else {
         const float disc = rc * rc + (top - h) * (2.0f * m.R0 + top + h); // r² cos² + Rtop² − r²
         const float d = -rc + sqrtf(disc > 0.0f ? disc : 0.0f);
         const float span = rho + H - (top - h);
         const float t = span > 0.0f ? (d - (top - h)) / span : 0.0f;
-        in[0] = t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f;
+        in[0] = kHorizonGap + kHorizonSpan * (t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f);
     }
     in[3] = 2.0f * rho / H - 1.0f;
 }

@@ -306,9 +306,13 @@ TEST(NeuralEncoding, DecodeRuleBelowTheOffsetIsZero) {
 TEST(NeuralErrorBound, CoversTheBatchAgainstTheScalarPassAndIsNotVacuous) {
     // The bound the GPU tests use (error_bound_test_util.h), tried on the two
     // CPU evaluators, which round differently too (Eigen's order and exp).
-    for (const char* topology : {"paper", "independent:16x16", "shared:32x32"}) {
+    for (const char* topology : {"paper", "independent:16x16", "shared:32x32", "shared:16x12 horizon/phase-factored"}) {
         SCOPED_TRACE(topology);
-        const NeuralSky net = neural_test::random_network(topology, 5);
+        const bool factored = std::string(topology).find(' ') != std::string::npos;
+        const NeuralSky net = factored ? neural_test::with_encoding(neural_test::random_network("shared:16x12", 5),
+                                                                    InputEncoding::Horizon,
+                                                                    OutputEncoding::PhaseFactored, 6)
+                                       : neural_test::random_network(topology, 5);
         const auto e = neural_test::encoded_error_bound(net);
         std::printf("%s: modelled bound on the encoded outputs %.2e %.2e %.2e %.2e\n", topology, e[0], e[1], e[2], e[3]);
         if (std::string(topology) == "paper")
@@ -527,14 +531,14 @@ TEST(NeuralEncoding, HorizonInputsPutTheHorizonsSidesFarApart) {
         const double horizon = -std::sqrt(1.0 - (R0 / (R0 + h)) * (R0 / (R0 + h))); // cos of the horizon
         float in[4];
         encode_inputs(m, 1.0f, 0.3f, 0.5f, rho, in);
-        EXPECT_NEAR(in[0], 0.0f, 1e-4) << h; // zenith: the shortest up ray
+        EXPECT_NEAR(in[0], kHorizonGap, 1e-4) << h; // zenith: the shortest up ray
         EXPECT_FLOAT_EQ(in[1], 0.3f);
         encode_inputs(m, float(horizon + 1e-5), 0.3f, 0.5f, rho, in);
         EXPECT_GT(in[0], 0.95f) << h; // just above the horizon: near +1
         encode_inputs(m, float(horizon - 1e-5), 0.3f, 0.5f, rho, in);
         EXPECT_LT(in[0], -0.9f) << h; // just below: near −1
         encode_inputs(m, -1.0f, 0.3f, 0.5f, rho, in);
-        EXPECT_NEAR(in[0], 0.0f, 1e-3) << h; // nadir: the shortest ground ray
+        EXPECT_NEAR(in[0], -kHorizonGap, 1e-3) << h; // nadir: the shortest ground ray
         // Bruneton's altitude coordinate, in [−1, 1].
         const double top = atm.top_radius_km - R0;
         EXPECT_NEAR(in[3], 2.0 * std::sqrt(h * (2.0 * R0 + h) / (top * (2.0 * R0 + top))) - 1.0, 1e-4) << h;
@@ -726,4 +730,90 @@ TEST(NeuralPhaseFactored, ReproducesASkyBuiltFromTheFactorisation) {
     std::printf("held-out mean relative error: phase-factored %.3f%%, radiance outputs %.3f%%\n", 100 * f, 100 * r);
     EXPECT_LT(f, 0.01);
     EXPECT_LT(f, 0.2 * r);
+}
+
+namespace {
+
+// The table's encoded outputs at one input, by an independent quadrilinear
+// interpolation over t.values (plain loops over the 16 corners).
+double table_code(const SkyLookupTable& t, const float* in, int out) {
+    double f[4];
+    int base[4];
+    for (int a = 0; a < 4; ++a) {
+        double u = (double(in[a]) - t.lo[std::size_t(a)]) / (t.hi[std::size_t(a)] - t.lo[std::size_t(a)]) *
+                   (t.size[std::size_t(a)] - 1);
+        u = std::clamp(u, 0.0, double(t.size[std::size_t(a)] - 1));
+        base[a] = std::min(int(u), t.size[std::size_t(a)] - 2);
+        f[a] = u - base[a];
+    }
+    const int outputs = t.encoding.output_count();
+    double sum = 0.0;
+    for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j)
+            for (int k = 0; k < 2; ++k)
+                for (int l = 0; l < 2; ++l) {
+                    const std::size_t node =
+                        std::size_t(base[0] + i) +
+                        std::size_t(t.size[0]) *
+                            (std::size_t(base[1] + j) +
+                             std::size_t(t.size[1]) *
+                                 (std::size_t(base[2] + k) + std::size_t(t.size[2]) * std::size_t(base[3] + l)));
+                    const double w = (i ? f[0] : 1 - f[0]) * (j ? f[1] : 1 - f[1]) * (k ? f[2] : 1 - f[2]) *
+                                     (l ? f[3] : 1 - f[3]);
+                    sum += w * t.values[node * std::size_t(outputs) + std::size_t(out)];
+                }
+    return sum;
+}
+
+} // namespace
+
+TEST(SkyLookupTableFit, IsTheLeastSquaresOptimumAndGrowsMoreAccurate) {
+    SkyModelOptions so;
+    so.tables = {128, 64};
+    const SkyModel model(atmosphere_preset("earth"), so);
+    NeuralTrainOptions o;
+    o.samples = 20000;
+    o.max_n_samples = 20000;
+    for (OutputEncoding outputs : {OutputEncoding::Radiance, OutputEncoding::PhaseFactored}) {
+        o.outputs = outputs;
+        const SkyLookupTable t = fit_sky_lookup_table(model, o, 1200);
+        const int n = t.encoding.output_count();
+        EXPECT_EQ(t.float_count(), std::size_t(t.size[0] * t.size[1] * t.size[2] * t.size[3] * n));
+        EXPECT_LE(t.float_count(), 1200u);
+        EXPECT_GT(t.float_count(), 1200u / 2);
+        // The fit's loss (per output, masked squared error of the codes on the
+        // same training data) cannot fall when any node moves either way.
+        const TrainingData d = make_training_data(model, t.encoding, o.samples, stream_seed(o.seed, 0), o.device);
+        std::mt19937 rng(3);
+        for (int trial = 0; trial < 12; ++trial) {
+            const int out = int(rng() % unsigned(n));
+            const std::size_t node = rng() % (t.float_count() / std::size_t(n));
+            auto loss = [&](const SkyLookupTable& u) {
+                double l = 0.0;
+                for (std::size_t i = 0; i < d.size(); ++i) {
+                    const double e = table_code(u, d.x.col(Eigen::Index(i)).data(), out) - d.t(out, Eigen::Index(i));
+                    l += d.mask(out, Eigen::Index(i)) * e * e;
+                }
+                return l;
+            };
+            const double best = loss(t);
+            for (float step : {-1e-3f, 1e-3f}) {
+                SkyLookupTable u = t;
+                u.values[node * std::size_t(n) + std::size_t(out)] += step;
+                EXPECT_GE(loss(u), best * (1 - 1e-9)) << "output " << out << ", node " << node;
+            }
+        }
+        // More nodes, lower held-out error.
+        NeuralErrorOptions eo;
+        eo.samples = 5000;
+        eo.views = false;
+        const SkyLookupTable coarse = fit_sky_lookup_table(model, o, 16 * std::size_t(n)); // 2 nodes per input
+        const SkyLookupTable fine = fit_sky_lookup_table(model, o, 1296 * std::size_t(n));  // 6 per input
+        const double small = measure_sky_lookup_table_error(coarse, eo).all.mean;
+        const double large = measure_sky_lookup_table_error(fine, eo).all.mean;
+        std::printf("%s: table of %zu floats %.2f%%, of %zu floats %.2f%%\n", output_encoding_name(outputs),
+                    coarse.float_count(), 100 * small, fine.float_count(), 100 * large);
+        EXPECT_LT(large, small);
+    }
+    EXPECT_THROW(fit_sky_lookup_table(model, o, 10), Error);
 }

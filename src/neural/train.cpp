@@ -383,10 +383,14 @@ NeuralSky neural::train_network(NeuralSky net, const TrainingData& train, const 
 
     // --- Levenberg–Marquardt, one sub-network at a time --------------------------------
     const double Pd = double(lay.subnet_params);
+    // Automatic: the normal equations cost rows × P² with one row per sample
+    // and output of the sub-network; about 1e10 of that per iteration, at
+    // most 200,000 and at least 10 P samples.
+    const double rows_per_sample = double(lay.outputs);
     const std::size_t n_lm =
         o.lm_samples ? std::min(o.lm_samples, train.size())
-                     : std::min(train.size(),
-                                std::max(std::size_t(10.0 * Pd), std::size_t(std::min(2e5, 4e9 / (Pd * Pd)))));
+                     : std::min(train.size(), std::max(std::size_t(10.0 * Pd),
+                                                       std::size_t(std::min(2e5, 1e10 / (Pd * Pd * rows_per_sample)))));
     std::vector<double> lambda(std::size_t(lay.subnets), 1e-3);
     std::vector<bool> done(std::size_t(lay.subnets), false);
     int lm_run = 0;

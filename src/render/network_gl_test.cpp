@@ -10,6 +10,7 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include "neural/error_bound_test_util.h"
 #include "neural/internal.h"
 #include "neural/mlp_hd.h"
 #include "gl/gl.h"
@@ -127,6 +128,25 @@ TEST(GlNetwork, WiderSharedTopologyMatchesToo) {
     EXPECT_GT(compared, 5000);
     EXPECT_LT(err, 1e-5);
     std::printf("GLSL network (shared:16x16) vs mlp_hd.h: max relative error %.3g over %d inputs\n", err, compared);
+}
+
+// Horizon inputs and phase-factored outputs: the encoding constants after the
+// weights in the uniform block (atmosphere radii, phase terms) reach the GLSL.
+TEST(GlNetwork, EveryEncodingMatchesTheCppForwardPass) {
+    for (InputEncoding inputs : {InputEncoding::Seed, InputEncoding::Horizon})
+        for (OutputEncoding outputs : {OutputEncoding::Radiance, OutputEncoding::PhaseFactored}) {
+            NeuralSky net = neural_test::with_encoding(neural_test::random_network("shared:12x8", 7), inputs,
+                                                       outputs, 8);
+            for (float& w : net.weights)
+                w *= 0.5f; // moderate codes: the test compares arithmetic, not saturated sigmoids
+            int compared = 0;
+            const double err = glsl_network_error(net, &compared);
+            SCOPED_TRACE(std::string(input_encoding_name(inputs)) + " / " + output_encoding_name(outputs));
+            EXPECT_GT(compared, 3000);
+            EXPECT_LT(err, 1e-5);
+            std::printf("GLSL network (%s inputs, %s outputs) vs mlp_hd.h: max relative error %.3g over %d inputs\n",
+                        input_encoding_name(inputs), output_encoding_name(outputs), err, compared);
+        }
 }
 
 // The uniform-block source depends on the topology and the encoding only.
