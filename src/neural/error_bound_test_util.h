@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -17,13 +18,8 @@
 
 namespace skybake::neural_test {
 
-// A network with fixed pseudo-random weights (not trained: the evaluators
-// must agree whatever the weights are).
-inline NeuralSky random_network(const char* topology, unsigned seed) {
-    NeuralSky net;
-    net.topology = parse_topology(topology);
-    net.atmosphere = atmosphere_preset("earth");
-    net.encoding.max_n = 0.05;
+// Fills the weights with fixed pseudo-random values in [−1.5, 1.5].
+inline NeuralSky with_random_weights(NeuralSky net, unsigned seed) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> u(-1.5f, 1.5f);
     net.weights.resize(std::size_t(net.topology.weight_count()));
@@ -31,6 +27,16 @@ inline NeuralSky random_network(const char* topology, unsigned seed) {
         w = u(rng);
     net.validate();
     return net;
+}
+
+// A network with fixed pseudo-random weights (not trained: the evaluators
+// must agree whatever the weights are).
+inline NeuralSky random_network(const char* topology, unsigned seed) {
+    NeuralSky net;
+    net.topology = parse_topology(topology);
+    net.atmosphere = atmosphere_preset("earth");
+    net.encoding.max_n = 0.05;
+    return with_random_weights(std::move(net), seed);
 }
 
 // The same network with other encodings: phase terms from its atmosphere's
@@ -47,13 +53,7 @@ inline NeuralSky with_encoding(NeuralSky net, InputEncoding inputs, OutputEncodi
             net.encoding.terms.push_back({c.name, c.phase, c.phase_g, glm::dvec3(2.0, 4.0, 8.0) * double(k + 1)});
         }
     net.topology.outputs = net.encoding.output_count();
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(-1.5f, 1.5f);
-    net.weights.resize(std::size_t(net.topology.weight_count()));
-    for (float& w : net.weights)
-        w = u(rng);
-    net.validate();
-    return net;
+    return with_random_weights(std::move(net), seed);
 }
 
 // A model of how far the encoded outputs move when every product-sum and
