@@ -19,7 +19,11 @@ using json = nlohmann::json;
 namespace {
 
 constexpr const char* kFormat = "skybake-neural-sky";
-constexpr int kVersion = 2; // 2: input and output encodings, topology.outputs; 1 still loads
+// 1: the seed's inputs and radiance outputs. 2: input and output encodings,
+// topology.outputs. 3: horizon inputs put the zenith and nadir 2 * kHorizonGap
+// apart. Versions 1 and 3 load, and so does version 2 with seed inputs;
+// version 2's horizon inputs (no gap) are refused rather than misread.
+constexpr int kVersion = 3;
 
 } // namespace
 
@@ -253,6 +257,10 @@ NeuralSky neural_sky_from_json(std::string_view text, const std::string& where) 
             if (!in.is_string() || !out.is_string())
                 throw Error("encoding.inputs and encoding.outputs must be names", where);
             net.encoding.inputs = parse_input_encoding(in.get<std::string>(), where + ": encoding.inputs");
+            if (version == 2 && net.encoding.inputs == InputEncoding::Horizon)
+                throw Error("version 2 horizon inputs had no zenith-nadir gap and are no longer read; retrain the "
+                            "network with this version",
+                            where + ": encoding.inputs");
             net.encoding.outputs = parse_output_encoding(out.get<std::string>(), where + ": encoding.outputs");
             if (net.encoding.outputs == OutputEncoding::PhaseFactored) {
                 const json& terms = field(enc, "terms", where + ": encoding");

@@ -583,10 +583,10 @@ TEST(NeuralFile, VersionOneFilesLoadAndGiveTheSameOutputs) {
             ASSERT_TRUE(f >> r >> c1 >> g >> c2 >> b);
             EXPECT_EQ(got[i], glm::vec3(r, g, b)) << "sample " << i; // bitwise: 9 digits round-trip a float
         }
-        // Written again, it is a version 2 file that loads to the same network.
+        // Written again, it is a version 3 file that loads to the same network.
         const NeuralSky back = neural_sky_from_json(neural_sky_to_json(net));
         EXPECT_EQ(back.weights, net.weights);
-        EXPECT_EQ(nlohmann::json::parse(neural_sky_to_json(net))["version"], 2);
+        EXPECT_EQ(nlohmann::json::parse(neural_sky_to_json(net))["version"], 3);
     }
 }
 
@@ -627,6 +627,12 @@ TEST(NeuralFile, EncodingsRoundTripAndMismatchesAreErrors) {
     bad = j;
     bad["encoding"].erase("terms");
     fails(bad, "terms");
+    // Version 2 horizon inputs had no zenith-nadir gap: refused, not misread.
+    bad = j;
+    bad["version"] = 2;
+    fails(bad, "retrain");
+    bad["encoding"]["inputs"] = "seed"; // version 2 seed inputs mean the same as today
+    EXPECT_EQ(neural_sky_from_json(bad.dump()).weights, net.weights);
 }
 
 TEST(NeuralPhaseFactored, SplitSumsTimesThePhasesAreTheSky) {
