@@ -363,6 +363,20 @@ TEST(NeuralTraining, LossDecreasesAndIsDeterministic) {
         EXPECT_LE(curve[i].train_rms, curve[i - 1].train_rms * (1.0 + 1e-6));
     EXPECT_GT(a.encoding.max_n, 0.0);
     EXPECT_EQ(a.training.samples, 4000u);
+    // The default encodings (horizon inputs, phase-factored outputs) too.
+    o.inputs = InputEncoding::Horizon;
+    o.outputs = OutputEncoding::PhaseFactored;
+    o.topology = parse_topology("shared:8x6");
+    set_thread_count(2);
+    const NeuralSky c = train_neural_sky(model, o);
+    set_thread_count(1);
+    const NeuralSky d = train_neural_sky(model, o);
+    set_thread_count(threads);
+    EXPECT_EQ(c.encoding.outputs, OutputEncoding::PhaseFactored);
+    EXPECT_EQ(c.weights, d.weights);
+    EXPECT_EQ(c.encoding.terms.size(), d.encoding.terms.size());
+    for (std::size_t k = 0; k < c.encoding.terms.size() && k < d.encoding.terms.size(); ++k)
+        EXPECT_EQ(c.encoding.terms[k].max_s, d.encoding.terms[k].max_s);
 }
 
 TEST(NeuralFile, RoundTripIsExact) {
