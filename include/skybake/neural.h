@@ -388,6 +388,8 @@ Image render_neural_sky_cuda(const NeuralSky& net, const SkyModel& tables, const
 
 // PSNR in dB of two images of the same size after tone mapping both with tm
 // and the sRGB transfer function (display values in [0, 1], not quantised).
+// A NaN or infinite value counts as the largest error, 1; identical images
+// give 999 dB.
 double image_psnr_db(const Image& reference, const Image& test, const ToneMap& tm);
 
 } // namespace skybake

@@ -85,6 +85,15 @@ struct TrainingData {
     double mask_count = 0.0;
     std::size_t size() const { return radiance.size(); }
 };
+// fit_sky_lookup_table minimises, per output, with D the mean over nodes of
+// Σ_samples mask w_j² (the normal matrix's mean diagonal):
+//   Σ_samples mask (Σ_j w_j v_j − t)²  +  kTableRidge D Σ_j v_j²
+//     +  kTableSmoothing D Σ_(neighbours j, k along one input) (v_j − v_k)²
+// The smoothing keeps nodes that few samples touch near their neighbours:
+// without it, the least squares put them anywhere (codes of ±170 at 8⁴ nodes
+// for codes that lie in [0, 1]) and their cells overflowed the decoding.
+constexpr double kTableRidge = 1e-6, kTableSmoothing = 1e-3;
+
 // The encoding train_neural_sky trains with: options' encodings, max{N}
 // (and max S per phase term) over options.max_n_samples samples. Throws
 // skybake::Error naming the option for combinations that cannot work.

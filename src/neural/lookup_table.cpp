@@ -116,7 +116,7 @@ SkyLookupTable fit_sky_lookup_table(const SkyModel& model, const NeuralTrainOpti
     const int nodes = t.size[0] * t.size[1] * t.size[2] * t.size[3];
     const TrainingData d = make_training_data(model, t.encoding, o.samples, stream_seed(o.seed, 0), o.device);
 
-    // Per output, min Σ mask (Σ_j w_j v_j − t)² + λ Σ v²: normal equations with
+    // Per output, the objective of internal.h (kTableRidge): normal equations with
     // 16 × 16 blocks per sample. The mask is the same for R, G, B (radiance
     // outputs) and 1 elsewhere, so outputs with the same mask share a matrix.
     t.values.assign(std::size_t(nodes) * std::size_t(outputs), 0.0f);
@@ -181,9 +181,23 @@ SkyLookupTable fit_sky_lookup_table(const SkyModel& model, const NeuralTrainOpti
                     if (c == 40)
                         diagonal += v;
                 }
+            // A small first-difference penalty along every input keeps nodes
+            // that few samples touch near their neighbours instead of free.
+            const double smooth = kTableSmoothing * std::max(1e-30, diagonal / double(nodes));
+            for (int j = 0; j < nodes; ++j)
+                for (int axis = 0, p = 1; axis < 4; ++axis, p *= 3) {
+                    const int at = (j / stride[std::size_t(axis)]) % t.size[std::size_t(axis)];
+                    if (at + 1 >= t.size[std::size_t(axis)])
+                        continue;
+                    const int other = j + stride[std::size_t(axis)];
+                    entries.emplace_back(j, j, smooth);
+                    entries.emplace_back(other, other, smooth);
+                    entries.emplace_back(j, other, -smooth);
+                    entries.emplace_back(other, j, -smooth);
+                }
             Eigen::SparseMatrix<double> A(nodes, nodes);
             A.setFromTriplets(entries.begin(), entries.end());
-            const double ridge = 1e-6 * std::max(1e-30, diagonal / double(nodes));
+            const double ridge = kTableRidge * std::max(1e-30, diagonal / double(nodes));
             for (int j = 0; j < nodes; ++j)
                 A.coeffRef(j, j) += ridge;
             solver.compute(A);

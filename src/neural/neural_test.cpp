@@ -755,8 +755,9 @@ TEST(NeuralPhaseFactored, ReproducesASkyBuiltFromTheFactorisation) {
 namespace {
 
 // The table's encoded outputs at one input, by an independent quadrilinear
-// interpolation over t.values (plain loops over the 16 corners).
-double table_code(const SkyLookupTable& t, const float* in, int out) {
+// interpolation over t.values (plain loops over the 16 corners); sum_w2
+// receives the sum of the squared corner weights.
+double table_code(const SkyLookupTable& t, const float* in, int out, double* sum_w2 = nullptr) {
     double f[4];
     int base[4];
     for (int a = 0; a < 4; ++a) {
@@ -781,6 +782,8 @@ double table_code(const SkyLookupTable& t, const float* in, int out) {
                     const double w = (i ? f[0] : 1 - f[0]) * (j ? f[1] : 1 - f[1]) * (k ? f[2] : 1 - f[2]) *
                                      (l ? f[3] : 1 - f[3]);
                     sum += w * t.values[node * std::size_t(outputs) + std::size_t(out)];
+                    if (sum_w2)
+                        *sum_w2 += w * w;
                 }
     return sum;
 }
@@ -808,11 +811,28 @@ TEST(SkyLookupTableFit, IsTheLeastSquaresOptimumAndGrowsMoreAccurate) {
         for (int trial = 0; trial < 12; ++trial) {
             const int out = int(rng() % unsigned(n));
             const std::size_t node = rng() % (t.float_count() / std::size_t(n));
+            // internal.h's objective: the data term, then ridge and smoothing.
             auto loss = [&](const SkyLookupTable& u) {
-                double l = 0.0;
+                double l = 0.0, diagonal = 0.0;
                 for (std::size_t i = 0; i < d.size(); ++i) {
-                    const double e = table_code(u, d.x.col(Eigen::Index(i)).data(), out) - d.t(out, Eigen::Index(i));
-                    l += d.mask(out, Eigen::Index(i)) * e * e;
+                    double w2 = 0.0;
+                    const double e =
+                        table_code(u, d.x.col(Eigen::Index(i)).data(), out, &w2) - d.t(out, Eigen::Index(i));
+                    const double m = d.mask(out, Eigen::Index(i));
+                    l += m * e * e;
+                    diagonal += m * w2;
+                }
+                const std::size_t nodes = u.float_count() / std::size_t(n);
+                const double dm = diagonal / double(nodes);
+                for (std::size_t j = 0; j < nodes; ++j) {
+                    const double v = u.values[j * std::size_t(n) + std::size_t(out)];
+                    l += kTableRidge * dm * v * v;
+                    for (int axis = 0, stride = 1; axis < 4; stride *= u.size[std::size_t(axis)], ++axis) {
+                        if ((int(j) / stride) % u.size[std::size_t(axis)] + 1 >= u.size[std::size_t(axis)])
+                            continue;
+                        const double dv = v - u.values[(j + std::size_t(stride)) * std::size_t(n) + std::size_t(out)];
+                        l += kTableSmoothing * dm * dv * dv;
+                    }
                 }
                 return l;
             };
@@ -836,4 +856,19 @@ TEST(SkyLookupTableFit, IsTheLeastSquaresOptimumAndGrowsMoreAccurate) {
         EXPECT_LT(large, small);
     }
     EXPECT_THROW(fit_sky_lookup_table(model, o, 10), Error);
+}
+
+TEST(ImagePsnr, IsTheClosedFormAndANaNPixelIsTheLargestError) {
+    // Clamped tone map, and values whose sRGB codes are 0 and 1: one of 4
+    // pixels wrong by 1 in all three channels is MSE 1/4, 6.02 dB.
+    const ToneMap tm{0.0f, ToneCurve::Clamp};
+    Image a(2, 2), b(2, 2);
+    EXPECT_EQ(image_psnr_db(a, b, tm), 999.0); // identical
+    for (int c = 0; c < 3; ++c)
+        b.pixel(1, 1)[c] = 1.0f;
+    EXPECT_NEAR(image_psnr_db(a, b, tm), 10 * std::log10(4.0), 1e-5); // sRGB(1) in float
+    b.pixel(1, 1)[0] = b.pixel(1, 1)[1] = b.pixel(1, 1)[2] = std::nanf("");
+    EXPECT_NEAR(image_psnr_db(a, b, tm), 10 * std::log10(4.0), 1e-9); // was 999 dB: NaN compared false
+    b.pixel(1, 1)[0] = b.pixel(1, 1)[1] = b.pixel(1, 1)[2] = std::numeric_limits<float>::infinity();
+    EXPECT_NEAR(image_psnr_db(a, b, tm), 10 * std::log10(4.0), 1e-9); // not clamped to 1 and counted as 1 - sRGB(1)
 }

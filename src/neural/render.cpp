@@ -55,7 +55,8 @@ double image_psnr_db(const Image& a, const Image& b, const ToneMap& tm) {
     for (std::size_t i = 0; i < a.rgb.size(); ++i) {
         const double x = linear_to_srgb(tone_map_value(a.rgb[i], tm));
         const double y = linear_to_srgb(tone_map_value(b.rgb[i], tm));
-        se += (x - y) * (x - y);
+        // A NaN or infinite value is the largest error (tone mapping would hide it).
+        se += std::isfinite(a.rgb[i]) && std::isfinite(b.rgb[i]) ? (x - y) * (x - y) : 1.0;
     }
     const double mse = se / double(std::max<std::size_t>(1, a.rgb.size()));
     return mse > 0.0 ? 10.0 * std::log10(1.0 / mse) : 999.0;
