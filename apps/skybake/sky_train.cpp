@@ -136,6 +136,12 @@ void add_sky_train(CLI::App& group) {
              "mean relative error {:.3g}% -> {}",
              net.topology.name(), net.topology.weight_count(), s.samples, atm.name, target, s.seconds, s.threads,
              s.heldout_rms, 100.0 * s.heldout_mean_relative, o->output);
+        // A network whose outputs all died (too large a first step for its
+        // width: 0.02 for shared:128x128) is saved, but said plainly.
+        if (s.heldout_mean_relative >= 0.99)
+            info("warning: the network did not learn (held-out mean relative error {:.3g}%); wide networks want a "
+                 "smaller --learning-rate (0.005 for 128 wide)",
+                 100.0 * s.heldout_mean_relative);
         if (o->json)
             print_json({{"atmosphere", atm.name},
                         {"target", target},
