@@ -77,6 +77,17 @@ TEST(NeuralCli, TrainWritesWeightsCurveAndChart) {
     EXPECT_GT(fs::file_size(dir + "/c.png"), 1000u);
 }
 
+TEST(NeuralCli, ANetworkThatDidNotLearnIsSavedWithAWarning) {
+    // Adam's first step 9 kills every output of a 64-wide network.
+    const std::string dir = temp_dir("neural_train_dead");
+    auto r = run_cli({"sky", "train", "--preset", "earth", "--samples", "20000", "--epochs", "3", "--lm-iterations",
+                      "0", "--topology", "shared:64x64", "--learning-rate", "9", "-o", dir + "/w.json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("warning: the network did not learn"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--learning-rate"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::exists(dir + "/w.json"));
+}
+
 TEST(NeuralCli, TrainRejectsBadFlags) {
     const std::string dir = temp_dir("neural_train_bad");
     for (const auto& args : std::vector<std::vector<std::string>>{
