@@ -136,7 +136,9 @@ Image draw_line_chart(const std::vector<ChartSeries>& series, const std::string&
     if (!std::isfinite(xmin)) {
         xmin = 0.0, xmax = 1.0, ymin = 0.1, ymax = 1.0;
     }
-    xmin = std::min(xmin, 0.0);
+    // From 0 when the data start near it (epochs); else from the data (log sizes).
+    if (xmin < 0.25 * (xmax - xmin))
+        xmin = std::min(xmin, 0.0);
     if (xmax <= xmin)
         xmax = xmin + 1.0;
     const double lo = std::floor(std::log10(ymin)), hi = std::max(lo + 1.0, std::ceil(std::log10(ymax)));

@@ -1,6 +1,7 @@
 // libFuzzer target: sphere rule specs (parse_rule, what `--rule` and the
 // sphere commands read). Whatever parses must be a rule whose weights are
 // finite and whose points are unit vectors.
+#include <cctype>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -20,8 +21,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // (and is cached on disk), and rules of millions of points take their
     // time to fill: slow by nature, not parser bugs. Counts up to 999,999 and
     // small designs keep every branch of the parser reachable.
-    if (const auto d = spec.find("design:"); d != std::string::npos) { // "design:tT" or "design:T"
-        const char* t = spec.c_str() + d + 7;
+    // Names are case-insensitive ("design:T40" is design:t40).
+    std::string lower = spec;
+    for (char& c : lower)
+        c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (const auto d = lower.find("design:"); d != std::string::npos) { // "design:tT" or "design:T"
+        const char* t = lower.c_str() + d + 7;
         if (std::atoi(*t == 't' ? t + 1 : t) > 12)
             return 0;
     }
