@@ -183,9 +183,9 @@ SkyLookupTable fit_sky_lookup_table(const SkyModel& model, const NeuralTrainOpti
                 }
             // A small first-difference penalty along every input keeps nodes
             // that few samples touch near their neighbours instead of free.
-            const double smooth = kTableSmoothing * std::max(1e-30, diagonal / double(nodes));
+            const double scale = std::max(1e-30, diagonal / double(nodes)), smooth = kTableSmoothing * scale;
             for (int j = 0; j < nodes; ++j)
-                for (int axis = 0, p = 1; axis < 4; ++axis, p *= 3) {
+                for (int axis = 0; axis < 4; ++axis) {
                     const int at = (j / stride[std::size_t(axis)]) % t.size[std::size_t(axis)];
                     if (at + 1 >= t.size[std::size_t(axis)])
                         continue;
@@ -197,7 +197,7 @@ SkyLookupTable fit_sky_lookup_table(const SkyModel& model, const NeuralTrainOpti
                 }
             Eigen::SparseMatrix<double> A(nodes, nodes);
             A.setFromTriplets(entries.begin(), entries.end());
-            const double ridge = kTableRidge * std::max(1e-30, diagonal / double(nodes));
+            const double ridge = kTableRidge * scale;
             for (int j = 0; j < nodes; ++j)
                 A.coeffRef(j, j) += ridge;
             solver.compute(A);
