@@ -1,14 +1,18 @@
 // Soak: the library called thousands of times in one process, as the Python
 // module and the Blender add-on will call it. Each cycle loads a mesh, bakes
 // it with Embree, writes and reloads it, builds a sky model, renders a small
-// sky and evaluates a network. Resident memory after the last cycle must stay
-// within 5% of what it was after the first tenth; in the sanitizer build
-// (fewer cycles) LeakSanitizer checks that nothing leaks at exit.
+// sky, evaluates a network, and creates and destroys a headless GL context
+// (compiling a program and drawing into a framebuffer with it). Resident
+// memory after the last cycle must stay within 5% of what it was after the
+// first tenth; in the sanitizer build (fewer cycles) LeakSanitizer checks that
+// nothing leaks at exit. That build leaves the GL cycle out: Mesa is not
+// built with the sanitizers and keeps allocations of its own for the process.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,7 +20,9 @@
 #include <unistd.h>
 
 #include "cli_runner.h"
+#include "gl/gl.h"
 #include "skybake/bake.h"
+#include "skybake/error.h"
 #include "skybake/mesh.h"
 #include "skybake/neural.h"
 #include "skybake/sky.h"
@@ -33,6 +39,36 @@ double resident_mib() {
     long pages = 0, resident = 0;
     statm >> pages >> resident;
     return double(resident) * double(::sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
+}
+
+#if !defined(SKYBAKE_ASAN)
+constexpr bool kGlCycle = true;
+#else
+constexpr bool kGlCycle = false;
+#endif
+
+// One GL cycle: a context, a program, a 4×4 target filled by a full-screen
+// triangle with a colour that depends on the cycle, read back; returns the
+// red value read, which must be the one drawn.
+float gl_cycle(int cycle) {
+    using namespace skybake;
+    const std::unique_ptr<gl::GlContext> context = gl::create_headless_context();
+    const gl::Program program = gl::link_program(
+        "soak",
+        gl::ShaderSource{{"#version 330 core\n", "void main() { vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);"
+                                                 " gl_Position = vec4(2.0 * p - 1.0, 0.0, 1.0); }\n"}},
+        gl::ShaderSource{{"#version 330 core\n", "uniform float u_red; out vec4 colour;"
+                                                 " void main() { colour = vec4(u_red, 0.25, 0.5, 1.0); }\n"}});
+    gl::RenderTarget target(4, 4);
+    target.bind();
+    glViewport(0, 0, 4, 4);
+    const gl::VertexArray vao = gl::make_vertex_array();
+    glBindVertexArray(vao.get());
+    glUseProgram(program.get());
+    glUniform1f(glGetUniformLocation(program.get(), "u_red"), float(cycle % 8) / 8.0f);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    gl::check_gl("soak draw");
+    return target.read_rgba()[4 * 5]; // pixel (1, 1)
 }
 
 } // namespace
@@ -61,6 +97,15 @@ TEST(Soak, MemoryStaysFlatOverManyCycles) {
     SkyRenderSettings view;
     view.width = view.height = 16;
     double after_tenth = 0.0, checksum = 0.0;
+    std::string gl_missing;
+    if (kGlCycle) {
+        try {
+            (void)gl::create_headless_context();
+        } catch (const Error& e) {
+            gl_missing = e.what(); // a machine without EGL: the rest still soaks
+        }
+    }
+    const bool with_gl = kGlCycle && gl_missing.empty();
     for (int c = 1; c <= cycles; ++c) {
         Mesh m = load_mesh(mesh_path);
         bake_ambient_occlusion(m, rule, "embree");
@@ -76,13 +121,22 @@ TEST(Soak, MemoryStaysFlatOverManyCycles) {
         evaluate_neural_sky(net, samples, radiance);
         checksum += radiance[7].x;
 
+        if (with_gl) {
+            const float red = gl_cycle(c);
+            ASSERT_EQ(red, float(c % 8) / 8.0f) << "cycle " << c; // exact in 8 bits and in float
+            checksum += red;
+        }
+
         if (c == cycles / 10)
             after_tenth = resident_mib();
     }
     const double at_end = resident_mib();
-    std::printf("soak: %d cycles; resident memory %.1f MiB after cycle %d, %.1f MiB after cycle %d (%+.2f%%); "
+    if (kGlCycle && !with_gl)
+        std::printf("soak: no GL context (%s); the GL cycle is left out\n", gl_missing.c_str());
+    std::printf("soak: %d cycles%s; resident memory %.1f MiB after cycle %d, %.1f MiB after cycle %d (%+.2f%%); "
                 "checksum %.6g\n",
-                cycles, after_tenth, cycles / 10, at_end, cycles, 100.0 * (at_end / after_tenth - 1.0), checksum);
+                cycles, with_gl ? " with GL" : "", after_tenth, cycles / 10, at_end, cycles,
+                100.0 * (at_end / after_tenth - 1.0), checksum);
 #if defined(SKYBAKE_ASAN)
     // AddressSanitizer keeps freed memory in quarantine (256 MiB by default):
     // resident memory grows by design there, and LeakSanitizer is the check.

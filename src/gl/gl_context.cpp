@@ -3,6 +3,14 @@
 // the device platform (EGL_EXT_device_enumeration + EGL_EXT_platform_device,
 // as NVIDIA's EGL provides). No window and no display server; rendering goes
 // to framebuffer objects.
+//
+// A context never terminates its display. An EGL display is one per platform
+// (or device) in a process, shared by every context on it: eglTerminate from
+// one context's destructor would release the others' too. And Mesa 22.3's
+// llvmpipe keeps about 8 KiB each time a display that has drawn is terminated
+// and initialised again, so a process that creates a context per bake grew
+// without end (tests/soak_slow_test.cpp). eglInitialize of an initialised
+// display does nothing, so every context after the first reuses it.
 #include <cstdlib>
 #include <cstring>
 #include <string>
@@ -99,10 +107,12 @@ public:
     }
     ~EglContext() override {
         if (display_ != EGL_NO_DISPLAY) {
-            eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+            if (eglGetCurrentContext() == context_) // another context that is current stays current
+                eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
             if (context_ != EGL_NO_CONTEXT)
                 eglDestroyContext(display_, context_);
-            eglTerminate(display_);
+            // The display stays initialised for the rest of the process (see
+            // the note at the top): it is shared by every context on it.
         }
     }
     void make_current() override {
@@ -124,7 +134,6 @@ private:
         const EGLint e = eglGetError();
         if (context_ != EGL_NO_CONTEXT)
             eglDestroyContext(display_, context_);
-        eglTerminate(display_);
         display_ = EGL_NO_DISPLAY;
         throw Error(fmt::format("{} ({})", what, egl_error_name(e)), kWhere);
     }

@@ -169,6 +169,32 @@ TEST(GlContext, ReportsDesktopGl33OrNewer) {
     EXPECT_GE(ctx->major_version() * 10 + ctx->minor_version(), 33) << ctx->description();
 }
 
+// Contexts share the process's EGL display: releasing one must leave another
+// working (a context that terminated the display took every other one with
+// it), and releasing one that is not current leaves the current one current.
+TEST(GlContext, ReleasingOneContextLeavesAnotherWorking) {
+    const auto clear_and_read = [](float red) {
+        RenderTarget target(2, 2);
+        target.bind();
+        glClearColor(red, 0.5f, 0.75f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+        check_gl("clear");
+        const std::vector<float> rgba = target.read_rgba();
+        return rgba.size() == 16 && rgba[1] == 0.5f && rgba[2] == 0.75f ? rgba[0] : -1.0f;
+    };
+    auto first = create_headless_context();
+    auto second = create_headless_context();
+    first.reset(); // the current one was the second
+    EXPECT_EQ(clear_and_read(0.25f), 0.25f);
+    auto third = create_headless_context();
+    second->make_current();
+    third.reset(); // not current: the second stays current
+    EXPECT_EQ(clear_and_read(0.125f), 0.125f);
+    second.reset();
+    auto fourth = create_headless_context(); // and a new one still comes up
+    EXPECT_EQ(clear_and_read(0.375f), 0.375f);
+}
+
 TEST(GlContext, NoPlatformIsOneClearError) {
     setenv("SKYBAKE_EGL_PLATFORM", "none", 1);
     try {
