@@ -13,7 +13,7 @@ PACKAGES=(
   # ray tracing and threading
   libembree-dev libtbb-dev
   # mesh and image I/O
-  libassimp-dev assimp-testmodels libtinygltf-dev libstb-dev libtinyexr-dev libpng-dev
+  libassimp-dev assimp-testmodels libtinygltf-dev libstb-dev libtinyexr-dev libpng-dev libjpeg62-turbo-dev
   # maths
   libglm-dev libeigen3-dev
   # CLI, formatting, JSON

@@ -1,21 +1,26 @@
-// Image files: PNG through stb_image(_write), EXR through tinyexr.
+// Image files: PNG and Radiance HDR through stb_image(_write), JPEG through
+// libjpeg-turbo, EXR through tinyexr.
 // Tone curve: K. Narkowicz, "ACES Filmic Tone Mapping Curve", 2015.
 #include "skybake/image.h"
 
 #include <algorithm>
 #include <climits>
 #include <cmath>
+#include <csetjmp>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <vector>
 
 #include <fmt/format.h>
+#include <jpeglib.h>
 #include <tinyexr.h>
 
 #include "skybake/error.h"
-#include "skybake/names.h"
 #include "skybake/files.h"
+#include "skybake/names.h"
 
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STB_IMAGE_WRITE_STATIC
@@ -23,7 +28,6 @@
 #define STB_IMAGE_IMPLEMENTATION
 #define STB_IMAGE_STATIC
 #define STBI_ONLY_PNG
-#define STBI_ONLY_JPEG
 #define STBI_ONLY_HDR
 #include <stb_image.h>
 
@@ -181,63 +185,76 @@ void check_pixels(std::int64_t w, std::int64_t h, std::uint64_t max_pixels, cons
                     name);
 }
 
-// Debian's stb_image (2.27) builds a JPEG Huffman table of as many codes as
-// the 16 counts of its DHT segment add up to, into arrays of 256: a corrupt
-// table writes past them. And a scan that uses a table no DHT defined yet
-// decodes with uninitialised memory, reading past the table. Every DHT table
-// is checked here first, read as stb_image reads it (tables follow each other
-// by their own sizes), and every scan's tables must be defined before it.
-void check_jpeg_huffman_tables(const unsigned char* d, std::size_t size, const std::string& name) {
-    bool defined[2][16] = {};
-    std::size_t i = 2; // after SOI
-    while (i + 1 < size) {
-        if (d[i] != 0xFF) {
-            ++i; // entropy-coded data
-            continue;
-        }
-        const unsigned m = d[i + 1];
-        if (m == 0xFF) {
-            ++i; // fill byte
-            continue;
-        }
-        if (m == 0x00 || m == 0x01 || (m >= 0xD0 && m <= 0xD8)) {
-            i += 2; // stuffing, TEM, RSTn, SOI: no length
-            continue;
-        }
-        if (m == 0xD9 || i + 4 > size)
-            return; // EOI
-        const std::size_t length = std::size_t(d[i + 2]) << 8 | d[i + 3];
-        if (m == 0xC4) {
-            long left = long(length) - 2;
-            std::size_t p = i + 4;
-            while (left > 0 && p < size) {
-                std::size_t n = 0; // stb_image reads bytes past the end as zeros
-                for (std::size_t k = 1; k <= 16; ++k)
-                    n += p + k < size ? d[p + k] : 0;
-                if (n > 256)
-                    throw Error(fmt::format("cannot decode image: corrupt JPEG (a Huffman table of {} codes; at most 256)",
-                                            n),
-                                name);
-                defined[d[p] >> 4 & 1][d[p] & 15] = true;
-                p += 17 + n;
-                left -= long(17 + n);
-            }
-        }
-        if (m == 0xDA && i + 5 <= size) { // SOS: components, then Ss, Se, Ah|Al
-            const std::size_t components = d[i + 4], o = i + 5 + 2 * components;
-            if (o + 3 > size)
-                return;
-            const unsigned ss = d[o], se = d[o + 1], ah = d[o + 2] >> 4;
-            for (std::size_t c = 0; c < components; ++c) {
-                const unsigned td = d[i + 6 + 2 * c] >> 4, ta = d[i + 6 + 2 * c] & 15;
-                if ((ss == 0 && ah == 0 && !defined[0][td]) || (se > 0 && !defined[1][ta]))
-                    throw Error(fmt::format("cannot decode image: corrupt JPEG (a scan uses a Huffman table that "
-                                            "no DHT segment defines before it)"),
-                                name);
-            }
-        }
-        i += 2 + length;
+// JPEG through libjpeg-turbo (Debian's stb_image 2.27 writes past its
+// Huffman tables on corrupt files, decodes with undefined tables and shifts
+// by 32 bits when a scan runs out of bits). libjpeg reports errors through a
+// callback that must not return: it jumps back here, past C frames only. A
+// warning (corrupt data, a premature end) is an error too: no half-decoded
+// image. Pixels are sRGB, decoded to linear like PNG's.
+struct JpegErrors {
+    jpeg_error_mgr mgr;
+    std::jmp_buf jump;
+    char message[JMSG_LENGTH_MAX];
+};
+
+[[noreturn]] void jpeg_fail(j_common_ptr c) {
+    auto* e = reinterpret_cast<JpegErrors*>(c->err);
+    (*c->err->format_message)(c, e->message);
+    std::longjmp(e->jump, 1);
+}
+
+void jpeg_message(j_common_ptr c, int level) {
+    if (level < 0) // a warning: the data is corrupt
+        jpeg_fail(c);
+}
+
+// Decodes into rgb8 (width × height × 3), unless the header's size is over
+// max_pixels (rgb8 stays empty: nothing that size is allocated). Returns an
+// empty string, or libjpeg's message.
+std::string decode_jpeg(const unsigned char* data, std::size_t size, std::uint64_t max_pixels,
+                        std::vector<unsigned char>& rgb8, int& width, int& height) {
+    jpeg_decompress_struct cinfo;
+    JpegErrors errors;
+    cinfo.err = jpeg_std_error(&errors.mgr);
+    errors.mgr.error_exit = jpeg_fail;
+    errors.mgr.emit_message = jpeg_message;
+    if (setjmp(errors.jump)) {
+        jpeg_destroy_decompress(&cinfo);
+        return errors.message;
     }
+    jpeg_create_decompress(&cinfo);
+    jpeg_mem_src(&cinfo, data, static_cast<unsigned long>(size));
+    jpeg_read_header(&cinfo, TRUE);
+    width = int(cinfo.image_width);
+    height = int(cinfo.image_height);
+    if (width <= 0 || height <= 0 || std::uint64_t(width) * std::uint64_t(height) > max_pixels) {
+        jpeg_destroy_decompress(&cinfo);
+        return {};
+    }
+    cinfo.out_color_space = JCS_RGB;
+    jpeg_start_decompress(&cinfo);
+    rgb8.resize(std::size_t(width) * std::size_t(height) * 3);
+    while (cinfo.output_scanline < cinfo.output_height) {
+        JSAMPROW row = rgb8.data() + std::size_t(cinfo.output_scanline) * std::size_t(width) * 3;
+        jpeg_read_scanlines(&cinfo, &row, 1);
+    }
+    jpeg_finish_decompress(&cinfo);
+    jpeg_destroy_decompress(&cinfo);
+    return {};
+}
+
+Image load_jpeg_from_memory(const unsigned char* data, std::size_t size, const std::string& name,
+                            std::uint64_t max_pixels) {
+    std::vector<unsigned char> rgb8;
+    int w = 0, h = 0;
+    const std::string message = decode_jpeg(data, size, max_pixels, rgb8, w, h);
+    if (!message.empty())
+        throw Error(fmt::format("cannot decode image: corrupt JPEG ({})", message), name);
+    check_pixels(w, h, max_pixels, "the", name); // throws when decode_jpeg stopped at the header
+    Image img(w, h);
+    for (std::size_t i = 0; i < img.rgb.size(); ++i)
+        img.rgb[i] = srgb_to_linear(float(rgb8[i]) / 255.0f);
+    return img;
 }
 
 // stb_image allocates a PNG chunk's stated length before it reads the chunk:
@@ -318,7 +335,7 @@ Image load_image_from_memory(const void* data, std::size_t size, const std::stri
     if (size > std::size_t(INT_MAX))
         throw Error(fmt::format("an image file of {} bytes is too large", size), name);
     if (size >= 2 && bytes[0] == 0xFF && bytes[1] == 0xD8)
-        check_jpeg_huffman_tables(bytes, size, name);
+        return load_jpeg_from_memory(bytes, size, name, max_pixels);
     if (size >= 8 && std::memcmp(bytes, "\x89PNG\r\n\x1a\n", 8) == 0)
         check_png_chunks(bytes, size, name);
     int w = 0, h = 0, comp = 0;

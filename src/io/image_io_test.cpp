@@ -11,6 +11,12 @@
 #include "skybake/error.h"
 #include "skybake/image.h"
 
+// stb_image, the reference decoder for JPEG here (skybake reads JPEG with libjpeg-turbo).
+#define STB_IMAGE_IMPLEMENTATION
+#define STB_IMAGE_STATIC
+#define STBI_ONLY_JPEG
+#include <stb/stb_image.h>
+
 using namespace skybake;
 namespace fs = std::filesystem;
 
@@ -92,30 +98,58 @@ TEST(ImageFiles, AHugeHeaderIsAnErrorNotAnAllocation) {
     EXPECT_THROW(load_image_from_memory(exr.data(), exr.size(), "exr", "small.exr", 31), Error);
 }
 
-// stb_image 2.27 builds a JPEG Huffman table of as many codes as its counts
-// add up to, into arrays of 256, and decodes a scan with a table that was never
-// defined: both are refused before stb reads them.
-TEST(ImageFiles, CorruptJpegHuffmanTablesAreErrors) {
+// JPEGs are decoded by libjpeg-turbo; Debian's stb_image 2.27 (the PNG and
+// HDR reader) is the independent decoder to compare with on a valid file.
+TEST(ImageFiles, JpegDecodesAsAnIndependentDecoderDoes) {
+    const fs::path path = "/usr/share/assimp/models/LWO/LWO2/MappingModes/earthSpherical.jpg";
+    if (!fs::exists(path))
+        GTEST_SKIP() << "assimp-testmodels is not installed";
+    std::ifstream in(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const Image img = load_image(path);
+    int w = 0, h = 0, comp = 0;
+    unsigned char* ref = stbi_load_from_memory(reinterpret_cast<const unsigned char*>(bytes.data()), int(bytes.size()),
+                                               &w, &h, &comp, 3);
+    ASSERT_NE(ref, nullptr) << stbi_failure_reason();
+    ASSERT_EQ(img.width, w);
+    ASSERT_EQ(img.height, h);
+    double sum = 0.0;
+    for (std::size_t i = 0; i < img.rgb.size(); ++i)
+        sum += std::abs(double(linear_to_srgb(img.rgb[i])) * 255.0 - double(ref[i]));
+    stbi_image_free(ref);
+    // The two differ only in IDCT and chroma upsampling rounding.
+    EXPECT_LT(sum / double(img.rgb.size()), 1.5) << "mean |difference| in 8-bit sRGB levels";
+    EXPECT_THROW(load_image_from_memory(bytes.data(), bytes.size() / 2, "jpg", "half.jpg"), Error); // truncated
+    EXPECT_THROW(load_image_from_memory(bytes.data(), bytes.size(), "jpg", "big.jpg", std::uint64_t(w) * h - 1), Error);
+}
+
+// Corrupt JPEGs are errors: a Huffman table of more than 256 codes and a scan
+// whose tables no DHT defined (stb_image 2.27 wrote past its tables and read
+// uninitialised ones), and a scan that runs out of bits where stb_image
+// shifted by 32 (found by the image fuzzer).
+TEST(ImageFiles, CorruptJpegsAreErrors) {
+    const auto expect_corrupt = [](const std::string& jpeg, const char* what) {
+        try {
+            load_image_from_memory(jpeg.data(), jpeg.size(), "jpg", "bad.jpg");
+            ADD_FAILURE() << what << " was accepted";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("corrupt JPEG"), std::string::npos) << e.what();
+            EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+        }
+    };
     std::string jpeg = "\xFF\xD8\xFF\xC4";
-    jpeg += std::string("\x00\x13\x00", 3);     // length 19: one table, class 0, id 0
-    jpeg += std::string(16, '\x20');             // 16 counts of 32: 512 codes
+    jpeg += std::string("\x00\x13\x00", 3); // length 19: one table, class 0, id 0
+    jpeg += std::string(16, '\x20');        // 16 counts of 32: 512 codes
     jpeg += std::string(512, '\x01') + "\xFF\xD9";
-    try {
-        load_image_from_memory(jpeg.data(), jpeg.size(), "jpg", "bad.jpg");
-        FAIL() << "a Huffman table of 512 codes was accepted";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("Huffman table of 512 codes"), std::string::npos) << e.what();
-    }
-    // A scan that uses tables no DHT defined: stb_image 2.27 decodes with uninitialised tables.
+    expect_corrupt(jpeg, "a Huffman table of 512 codes");
     std::string scan = "\xFF\xD8\xFF\xDA";
     scan += std::string("\x00\x08\x01\x01\x00\x00\x3F\x00", 8); // one component, tables 0/0, Ss 0, Se 63
     scan += std::string(64, '\x55') + "\xFF\xD9";
-    try {
-        load_image_from_memory(scan.data(), scan.size(), "jpg", "bad.jpg");
-        FAIL() << "a scan without Huffman tables was accepted";
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("no DHT segment defines"), std::string::npos) << e.what();
-    }
+    expect_corrupt(scan, "a scan without Huffman tables");
+    std::ifstream in(fs::path(SKYBAKE_SOURCE_DIR) / "tests/data/fuzz/jpeg_scan_out_of_bits.jpg", std::ios::binary);
+    const std::string out_of_bits((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_GT(out_of_bits.size(), 900u);
+    expect_corrupt(out_of_bits, "a progressive scan that runs out of bits");
 }
 
 TEST(ToneMap, SrgbTransferInverts) {
