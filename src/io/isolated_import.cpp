@@ -29,6 +29,16 @@
 #endif
 #endif
 
+#if defined(SKYBAKE_ASAN) || defined(__SANITIZE_UNDEFINED__)
+#include <sanitizer/common_interface_defs.h>
+#define SKYBAKE_SANITIZER_DEATH_CALLBACK 1
+#elif defined(__has_feature)
+#if __has_feature(undefined_behavior_sanitizer)
+#include <sanitizer/common_interface_defs.h>
+#define SKYBAKE_SANITIZER_DEATH_CALLBACK 1
+#endif
+#endif
+
 namespace skybake::io {
 
 namespace {
@@ -200,6 +210,12 @@ bool write_all(int fd, const std::string& s) {
     // reports the signal as one error line.
     for (int sig : {SIGALRM, SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT, SIGINT, SIGTERM})
         ::signal(sig, SIG_DFL);
+#if defined(SKYBAKE_SANITIZER_DEATH_CALLBACK)
+    // The same for a sanitizer's report in the child (an allocation ASan
+    // cannot make, as there is no address-space limit under ASan): a fuzzer's
+    // death callback would record the child's end as the fuzzer's crash.
+    __sanitizer_set_death_callback(nullptr);
+#endif
     // Die with the parent: a killed CLI must not leave a parser running.
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);
     if (::getppid() != parent)

@@ -43,12 +43,14 @@ run_one() {
   cp -n "$here/corpus/$t"/* "$work"/ 2>/dev/null || true
   [ "$t" = mesh_loader ] && seed_mesh_loader "$work"
   [ -f "$here/$t.dict" ] && dict=(-dict="$here/$t.dict")
-  ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 LSAN_OPTIONS=suppressions=$here/lsan.supp \
-    UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
-    "$build/fuzz_$t" "${dict[@]}" -max_total_time="$secs" -max_len=65536 -rss_limit_mb=4096 -timeout="$timeout" \
+  # The merge below runs every input again: it needs the same options (the
+  # leak suppressions above all), or a known third-party leak stops it.
+  local -a env=(ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=1 "LSAN_OPTIONS=suppressions=$here/lsan.supp"
+                UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1)
+  env "${env[@]}" "$build/fuzz_$t" "${dict[@]}" -max_total_time="$secs" -max_len=65536 -rss_limit_mb=4096 -timeout="$timeout" \
     -print_final_stats=1 -artifact_prefix="$crashes/" "$work" >"$log" 2>&1 || true
   # Keep what adds coverage (and every crash) in the repository's corpus.
-  "$build/fuzz_$t" -merge=1 "$here/corpus/$t" "$work" >>"$log" 2>&1 || true
+  env "${env[@]}" "$build/fuzz_$t" -merge=1 -artifact_prefix="$crashes/" "$here/corpus/$t" "$work" >>"$log" 2>&1 || true
   for c in "$crashes"/crash-* "$crashes"/leak-* "$crashes"/timeout-* "$crashes"/oom-*; do
     [ -f "$c" ] && cp -n "$c" "$here/corpus/$t/"
   done
