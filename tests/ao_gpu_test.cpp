@@ -9,6 +9,7 @@
 #include "skybake/bake.h"
 #include "skybake/core.h"
 #include "core/gpu_test.h"
+#include "core/test_paths.h"
 
 using skybake::test::run_cli;
 namespace fs = std::filesystem;
@@ -18,7 +19,7 @@ TEST(AoGpuCli, EveryMethodMatchesEmbree) {
     const std::string dir = skybake::test::temp_dir("ao-gpu-cli");
     const std::string city = dir + "/city.glb";
     ASSERT_EQ(run_cli({"mesh", "generate", "--kind", "city", "--triangles", "5000", "-o", city}).exit_code, 0);
-    const std::string spider = std::string(SKYBAKE_ASSIMP_MODELS) + "/OBJ/spider.obj";
+    const std::string spider = skybake::test::assimp_models() + "/OBJ/spider.obj";
     for (const std::string& in : {city, spider}) {
         SCOPED_TRACE(in);
         const std::string rule = "lebedev:1202";

@@ -17,6 +17,7 @@
 #include <gtest/gtest.h>
 
 #include "cli_runner.h"
+#include "core/test_paths.h"
 
 using skybake::test::CliResult;
 using skybake::test::run_cli;
@@ -367,7 +368,7 @@ TEST(CliContract, SignalsStopABakeAndAnImportCleanly) {
     const std::string dir = skybake::test::temp_dir("contract-signals");
     // A bake of a few seconds: 2CylinderEngine at 5810 directions.
     const std::string engine =
-        std::string(SKYBAKE_ASSIMP_MODELS) + "/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
+        skybake::test::assimp_models() + "/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb";
     // An import of a few seconds through the isolated Assimp reader: a large OBJ.
     const std::string obj = dir + "/big.obj";
     {

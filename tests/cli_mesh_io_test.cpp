@@ -7,13 +7,14 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
+#include "core/test_paths.h"
 
 using skybake::test::run_cli;
 using skybake::test::temp_dir;
 namespace fs = std::filesystem;
 
 namespace {
-const std::string kModels = SKYBAKE_ASSIMP_MODELS;
+const std::string kModels = skybake::test::assimp_models();
 
 void expect_one_line_error(const skybake::test::CliResult& r, int code = 1) {
     EXPECT_EQ(r.signal, 0) << "crashed with signal " << r.signal;

@@ -16,6 +16,7 @@
 #include "skybake/gltf_asset.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
+#include "core/test_paths.h"
 
 using namespace skybake;
 namespace fs = std::filesystem;
@@ -177,7 +178,7 @@ TEST(GltfInstances, BakeMatchesTheSceneFlattenedByHand) {
 
 TEST(GltfInstances, CliKeepsTheDocument) {
     const fs::path dir = skybake::test::temp_dir("gltf-instances-cli");
-    const fs::path sample = fs::path(SKYBAKE_ASSIMP_MODELS) / "glTF2" / "BoxTextured-glTF";
+    const fs::path sample = fs::path(skybake::test::assimp_models()) / "glTF2" / "BoxTextured-glTF";
     fs::copy(sample, dir, fs::copy_options::recursive);
     const auto r = skybake::test::run_cli(
         {"ao", (dir / "BoxTextured.gltf").string(), "-o", (dir / "baked.glb").string(), "--rule", "lebedev:50"});

@@ -10,6 +10,7 @@
 #include "cli_runner.h"
 #include "skybake/files.h"
 #include "skybake/image.h"
+#include "core/test_paths.h"
 
 using skybake::test::run_cli;
 namespace fs = std::filesystem;
@@ -27,7 +28,7 @@ Json glb_json(const fs::path& path) {
 // The milk truck (glTF 1.0, read through Assimp): a textured model whose UVs lie in [0, 1].
 fs::path truck(const std::string& name) {
     const fs::path dir = skybake::test::temp_dir(name);
-    fs::copy(fs::path(SKYBAKE_ASSIMP_MODELS) / "glTF" / "CesiumMilkTruck", dir, fs::copy_options::recursive);
+    fs::copy(fs::path(skybake::test::assimp_models()) / "glTF" / "CesiumMilkTruck", dir, fs::copy_options::recursive);
     return dir / "CesiumMilkTruck.gltf";
 }
 

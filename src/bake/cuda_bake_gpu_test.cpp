@@ -18,6 +18,7 @@
 #include "core/gpu_test.h"
 #include "skybake/bake.h"
 #include "visibility/cuda/cuda_backend.h"
+#include "core/test_paths.h"
 
 using namespace skybake;
 using namespace skybake::visibility;
@@ -74,7 +75,7 @@ TEST(CudaBackendGpu, EveryMethodMatchesEmbreeAndTheHostEmulation) {
 
 TEST(CudaBackendGpu, RealModelsMatchEmbree) {
     SKYBAKE_SKIP_WITHOUT_GPU();
-    const std::string models = SKYBAKE_ASSIMP_MODELS;
+    const std::string models = skybake::test::assimp_models();
     const Mesh engine = load_mesh(models + "/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb");
     const Mesh wuson = load_mesh(models + "/OBJ/WusonOBJ.obj");
     for (const auto& [name, m, spec] :

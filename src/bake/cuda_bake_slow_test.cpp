@@ -11,6 +11,7 @@
 #include "skybake/sphere.h"
 #include "bake/cuda_bake_test_util.h"
 #include "skybake/bake.h"
+#include "core/test_paths.h"
 
 using namespace skybake;
 using namespace skybake::visibility;
@@ -36,7 +37,7 @@ Agreement check(const std::string& label, const Mesh& m, const char* spec, bool 
 } // namespace
 
 TEST(CudaBakeSlow, RealModelsMatchEmbree) {
-    const std::string models = SKYBAKE_ASSIMP_MODELS;
+    const std::string models = skybake::test::assimp_models();
     check("2CylinderEngine", load_mesh(models + "/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb"),
           "lebedev:110+rotate", true);
     check("Wuson", load_mesh(models + "/OBJ/WusonOBJ.obj"), "lebedev:590", true);
@@ -57,7 +58,7 @@ TEST(CudaBakeSlow, TheGpuTestsSettingsPassOnTheHost) {
 
 TEST(CudaBakeSlow, TheGpuTestsRealModelsPassOnTheHost) {
     // cuda_bake_gpu_test.cpp, RealModelsMatchEmbree: strict bounds on both.
-    const std::string models = SKYBAKE_ASSIMP_MODELS;
+    const std::string models = skybake::test::assimp_models();
     for (const auto& [label, path, spec] :
          {std::tuple<const char*, const char*, const char*>{"engine", "/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb",
                                                             "lebedev:110+rotate"},

@@ -23,6 +23,7 @@
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 #include "skybake/visibility.h"
+#include "core/test_paths.h"
 
 using namespace skybake;
 using namespace skybake::ao_test;
@@ -76,7 +77,7 @@ Mesh with_normals(Mesh m) {
 }
 
 Mesh spider() {
-    return with_normals(load_mesh(std::string(SKYBAKE_ASSIMP_MODELS) + "/OBJ/spider.obj"));
+    return with_normals(load_mesh(skybake::test::assimp_models() + "/OBJ/spider.obj"));
 }
 
 constexpr TraceMethod kMethods[] = {TraceMethod::Cube, TraceMethod::Directional};

@@ -15,6 +15,7 @@
 #include "skybake/files.h"
 #include "skybake/gltf_asset.h"
 #include "skybake/mesh.h"
+#include "core/test_paths.h"
 
 using namespace skybake;
 namespace fs = std::filesystem;
@@ -22,7 +23,7 @@ using Json = nlohmann::json;
 
 namespace {
 
-const fs::path kGltf2 = fs::path(SKYBAKE_ASSIMP_MODELS) / "glTF2";
+const fs::path kGltf2 = fs::path(skybake::test::assimp_models()) / "glTF2";
 
 fs::path temp_dir(const std::string& name) {
     const fs::path dir = fs::temp_directory_path() / ("skybake-gltf-asset-test-" + std::to_string(::getpid())) / name;
@@ -254,11 +255,12 @@ TEST(GltfAsset, ImageUrisFollowTheOutputFolder) {
 }
 
 TEST(GltfAsset, RefusesOtherFormatsAndChangedMeshes) {
-    EXPECT_FALSE(GltfAsset::is_gltf2(fs::path(SKYBAKE_ASSIMP_MODELS) / "PLY" / "cube.ply"));
-    EXPECT_FALSE(GltfAsset::is_gltf2(fs::path(SKYBAKE_ASSIMP_MODELS) / "glTF" / "CesiumMilkTruck" /
+    EXPECT_FALSE(GltfAsset::is_gltf2(fs::path(skybake::test::assimp_models()) / "PLY" / "cube.ply"));
+    EXPECT_FALSE(GltfAsset::is_gltf2(fs::path(skybake::test::assimp_models()) / "glTF" / "CesiumMilkTruck" /
                                      "CesiumMilkTruck.gltf")); // glTF 1.0
-    EXPECT_THROW(GltfAsset::load(fs::path(SKYBAKE_ASSIMP_MODELS) / "glTF" / "CesiumMilkTruck" / "CesiumMilkTruck.gltf"),
-                 Error);
+    EXPECT_THROW(
+        GltfAsset::load(fs::path(skybake::test::assimp_models()) / "glTF" / "CesiumMilkTruck" / "CesiumMilkTruck.gltf"),
+        Error);
     const fs::path input = copy_sample("BoxTextured-glTF-Binary", "BoxTextured.glb", "box-changed");
     GltfAsset asset = GltfAsset::load(input);
     asset.mesh().positions.push_back({0, 0, 0});

@@ -17,13 +17,14 @@
 #include "skybake/error.h"
 #include "io/mesh_internal.h"
 #include "skybake/mesh.h"
+#include "core/test_paths.h"
 
 using namespace skybake;
 namespace fs = std::filesystem;
 
 namespace {
 
-const fs::path kModels = SKYBAKE_ASSIMP_MODELS;
+const fs::path kModels = skybake::test::assimp_models();
 
 fs::path temp(const std::string& name) {
     const fs::path dir = fs::temp_directory_path() / ("skybake-io-test-" + std::to_string(::getpid()));

@@ -11,6 +11,7 @@
 
 #include "skybake/files.h"
 #include "skybake/mesh.h"
+#include "core/test_paths.h"
 
 using namespace skybake;
 namespace fs = std::filesystem;
@@ -18,7 +19,7 @@ using Json = nlohmann::json;
 
 namespace {
 
-const fs::path kModels = SKYBAKE_ASSIMP_MODELS;
+const fs::path kModels = skybake::test::assimp_models();
 
 fs::path temp(const std::string& name) {
     const fs::path dir = fs::temp_directory_path() / ("skybake-keeps-test-" + std::to_string(::getpid()));

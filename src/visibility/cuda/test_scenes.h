@@ -17,6 +17,7 @@
 #include "skybake/sphere.h"
 #include "skybake/visibility.h"
 #include "visibility/cuda/bvh.h"
+#include "core/test_paths.h"
 
 namespace skybake::visibility_test {
 
@@ -76,7 +77,7 @@ inline Mesh generated(ProceduralKind kind, std::uint64_t triangles) {
 }
 
 inline Mesh spider() {
-    const std::string path = std::string(SKYBAKE_ASSIMP_MODELS) + "/OBJ/spider.obj";
+    const std::string path = skybake::test::assimp_models() + "/OBJ/spider.obj";
     return load_mesh(path);
 }
 
