@@ -12,6 +12,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/parallel.h"
+#include "core/progress.h"
 #include "sky/multiple_scattering_lut.h"
 #include "sky/transmittance_table.h"
 
@@ -22,7 +23,8 @@ constexpr double kPiD = 3.14159265358979323846;
 constexpr int kRayPoints = 40;
 } // namespace
 
-std::vector<float> hillaire_psi_table(const Atmosphere& atm, const MultipleScatteringResolution& res) {
+std::vector<float> hillaire_psi_table(const Atmosphere& atm, const MultipleScatteringResolution& res,
+                                      Progress* progress) {
     const TransmittanceTable T(atm);
     const double R0 = atm.planet_radius_km, Rt = atm.top_radius_km, scale = sharpest_scale_height(atm);
     const double pu = 0.25 / kPiD;
@@ -65,6 +67,8 @@ std::vector<float> hillaire_psi_table(const Atmosphere& atm, const MultipleScatt
             const glm::dvec3 psi = L2 / (glm::dvec3(1.0) - fms);
             for (int k = 0; k < 3; ++k)
                 out[node * 3 + std::size_t(k)] = float(psi[k]);
+            if (progress)
+                progress->advance();
         }
     });
     return out;

@@ -24,6 +24,7 @@
 #include <glm/geometric.hpp>
 
 #include "core/parallel.h"
+#include "core/progress.h"
 #include "sky/transmittance_table.h"
 
 namespace skybake::sky {
@@ -150,8 +151,14 @@ void Grid4Shape::node(std::size_t index, double& r, double& mu, double& mu_s, do
     nu = std::clamp(nu, mu * mu_s - spread, mu * mu_s + spread);
 }
 
+std::uint64_t ScatteringOrders::progress_units(const MultipleScatteringResolution& res, int orders) {
+    const std::uint64_t n = std::uint64_t(res.r) * 2u * std::uint64_t(res.mu) * std::uint64_t(res.mu_s) *
+                            std::uint64_t(res.nu);
+    return n + 2u * n * std::uint64_t(orders - 1);
+}
+
 ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const MultipleScatteringResolution& res, int orders,
-                                           bool keep_orders) {
+                                           bool keep_orders, Progress* progress) {
     assert(orders >= 2);
     ScatteringOrders out;
     out.atmosphere_ = atm;
@@ -176,6 +183,10 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
         const AtmosphereComponent& a = atm.components[k];
         return phase_function(a.phase, a.phase_g, c);
     };
+    const auto advance = [progress](std::size_t n) {
+        if (progress)
+            progress->advance(n);
+    };
     const auto ray_length = [&](double r, double mu, bool ground) {
         return ground ? std::max(0.0, ray_ground_distance(R0, r, mu)) : ray_top_distance(g.Rt, r, mu);
     };
@@ -197,6 +208,7 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
                     single[idx * K + k] += atm.components[k].scattering_per_km * relative_density(atm.components[k], rt - R0) * w;
             });
         }
+        advance(e - b);
     });
 
     // Radiance and ground irradiance of the previous order.
@@ -258,6 +270,7 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
                         ground_point[i] = (glm::dvec3(0.0, 0.0, r) + dg * wi) / R0;
                     }
                 }
+                advance(per_ray);
                 if (!any)
                     continue;
                 for (std::size_t q = 0; q < per_ray; ++q) {
@@ -311,6 +324,7 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
                 cur[idx] = s;
                 sum[idx] += s;
             }
+            advance(e - b);
         });
         if (keep_orders) {
             out.multiple_.push_back(cur);

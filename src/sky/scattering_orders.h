@@ -2,12 +2,17 @@
 // multiple_hd.h, in double precision on the CPU.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
 #include "skybake/sky.h"
 #include "sky/multiple_hd.h"
+
+namespace skybake {
+class Progress;
+}
 
 namespace skybake::sky {
 
@@ -28,9 +33,12 @@ struct Grid4Shape {
 class ScatteringOrders {
 public:
     // Orders 1..orders (orders ≥ 2). keep_orders: keep each order's grid for
-    // order_radiance(); otherwise only their sum from order 2 on.
+    // order_radiance(); otherwise only their sum from order 2 on. progress (may be
+    // null) advances by progress_units() in all.
     static ScatteringOrders compute(const Atmosphere& atmosphere, const MultipleScatteringResolution& resolution,
-                                    int orders, bool keep_orders = false);
+                                    int orders, bool keep_orders = false, Progress* progress = nullptr);
+    // The steps compute() reports: each node once for order 1, twice for each higher order.
+    static std::uint64_t progress_units(const MultipleScatteringResolution& resolution, int orders);
 
     const Grid4Shape& shape() const { return shape_; }
     int orders() const { return orders_; }

@@ -10,12 +10,13 @@
 #include <glm/geometric.hpp>
 
 #include "core/parallel.h"
+#include "core/progress.h"
 #include "sky/multiple_scattering_lut.h"
 
 namespace skybake::sky {
 
 std::vector<float> sky_irradiance_table(const AtmosphereHD& hd, const MultipleScatteringResolution& res, int steps,
-                                        int spacing) {
+                                        int spacing, Progress* progress) {
     constexpr double kPi = 3.14159265358979323846;
     const int n = std::max(4, res.sphere / 2); // polar bands on the hemisphere
     const double dth = 0.5 * kPi / double(n), dph = kPi / double(n);
@@ -43,6 +44,8 @@ std::vector<float> sky_irradiance_table(const AtmosphereHD& hd, const MultipleSc
             }
             for (int k = 0; k < 3; ++k)
                 out[node * 3 + std::size_t(k)] = float(E[k]);
+            if (progress)
+                progress->advance();
         }
     });
     return out;
