@@ -12,6 +12,11 @@
 find_package(GTest REQUIRED)
 include(GoogleTest)
 
+# Every test runs without the on-disk table cache (sky_table_cache_dir()): it
+# neither reads nor fills the user's cache, and always computes fresh tables.
+# The cache's own tests point SKYBAKE_CACHE_DIR at a folder of their own.
+set(SKYBAKE_TEST_ENVIRONMENT "SKYBAKE_CACHE_DIR=off")
+
 function(skybake_add_tests name)
   cmake_parse_arguments(T "" "" "FILES;LIBS" ${ARGN})
   set(groups unit io slow gpu gl)
@@ -55,7 +60,7 @@ function(skybake_add_tests name)
       set_property(GLOBAL APPEND PROPERTY SKYBAKE_IO_TEST_TARGETS ${exe})
     endif()
     gtest_discover_tests(${exe} TEST_PREFIX "${name}." DISCOVERY_MODE PRE_TEST
-      PROPERTIES LABELS ${g} TIMEOUT 600)
+      PROPERTIES LABELS ${g} TIMEOUT 600 ENVIRONMENT "${SKYBAKE_TEST_ENVIRONMENT}")
   endforeach()
 endfunction()
 

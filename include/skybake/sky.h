@@ -276,6 +276,16 @@ enum class SkyMethod : int {
 // tabulated from the model's own total radiance; the surface colour and the
 // rendered ground add it to the direct sun. A brute-force path tracer
 // (skybake/sky_path_tracer.h) is the reference for both methods.
+//
+// Building the tables takes seconds (orders: about 5 s for Earth on two
+// cores; see docs/PERFORMANCE.md), with a progress bar on a terminal. They are
+// cached on disk, in sky_table_cache_dir(), keyed by every input they depend
+// on (the atmosphere without its name and sun, the options below, the steps
+// and optical-length tables, the skybake version and the compiler), so the
+// next model of the same atmosphere reads them back in milliseconds, bit for
+// bit the tables it would compute. A missing, truncated or corrupt file is
+// recomputed and rewritten without a word; files are renamed into place
+// whole, so any number of processes may share the folder.
 struct MultipleScatteringResolution {
     int r = 16;        // radius nodes of the orders grid, ≥ 2
     int mu = 32;       // view-cosine nodes per half (above / below the horizon), ≥ 2
@@ -286,6 +296,13 @@ struct MultipleScatteringResolution {
     int irradiance_r = 8, irradiance_mu_s = 64; // sky irradiance table, ≥ 2 each
     double mu_s_min = -0.2; // lowest sun cosine of the orders grid (Bruneton: cos 102°), in (−1, 0]
 };
+
+// The folder of the table cache: $SKYBAKE_CACHE_DIR when set and not empty
+// ("off", "none" or "0": no cache, nothing read or written), else
+// $XDG_CACHE_HOME/skybake (an absolute XDG_CACHE_HOME), else
+// $HOME/.cache/skybake; empty (no cache) without HOME. Read at each SkyModel
+// construction.
+std::filesystem::path sky_table_cache_dir();
 
 struct SkyModelOptions {
     TableResolution tables{};
@@ -338,9 +355,13 @@ public:
     // altitude_km (≥ 0) with the sun at cos_sun_zenith, per unit sun irradiance
     // (the direct sun excluded). Zero for single scattering.
     glm::dvec3 sky_irradiance(double altitude_km, double cos_sun_zenith) const;
-    // Wall-clock seconds the constructor spent on the multiple-scattering tables, and their bytes.
+    // Wall-clock seconds the constructor spent on the multiple-scattering
+    // tables (computing them, or reading them from the cache), and their bytes.
     double multiple_precompute_seconds() const;
     std::size_t multiple_table_bytes() const;
+    // True when the multiple-scattering tables came from the cache (false for
+    // single scattering and for tables computed by this constructor).
+    bool multiple_tables_from_cache() const;
 
 private:
     friend const sky::AtmosphereHD& sky::atmosphere_hd(const SkyModel& model);

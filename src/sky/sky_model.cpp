@@ -7,10 +7,12 @@
 #include <cmath>
 
 #include "core/parallel.h"
+#include "core/progress.h"
 #include "skybake/error.h"
 #include "sky/internal.h"
 #include "sky/multiple_scattering_lut.h"
 #include "sky/scattering_orders.h"
+#include "sky/table_cache.h"
 
 namespace skybake {
 
@@ -22,6 +24,7 @@ struct SkyModel::Impl {
     // Multiple scattering (empty for single scattering).
     std::vector<float> orders, psi, irradiance;
     double multiple_seconds = 0.0;
+    bool multiple_cached = false;
 
     void build_multiple();
 };
@@ -50,25 +53,57 @@ void SkyModel::Impl::build_multiple() {
         return;
     const auto start = std::chrono::steady_clock::now();
     const MultipleScatteringResolution& res = options.multiple;
+    const bool orders_method = atmosphere.multiple_method == MultipleScatteringMethod::Orders;
     sky::MultipleHD& m = hd.ms;
     m.mu_s_min = float(res.mu_s_min);
-    if (atmosphere.multiple_method == MultipleScatteringMethod::Orders) {
-        orders = sky::ScatteringOrders::compute(atmosphere, res, atmosphere.scattering_orders).residual();
-        m.method = sky::kMultipleOrders;
-        m.orders = orders.data();
-        m.nr = res.r;
-        m.nmu = res.mu;
-        m.nmus = res.mu_s;
-        m.nnu = res.nu;
+    const auto point_at_main = [&](std::vector<float>& table) {
+        if (orders_method) {
+            orders = std::move(table);
+            m.method = sky::kMultipleOrders;
+            m.orders = orders.data();
+            m.nr = res.r;
+            m.nmu = res.mu;
+            m.nmus = res.mu_s;
+            m.nnu = res.nu;
+        } else {
+            psi = std::move(table);
+            m.method = sky::kMultipleHillaire;
+            m.psi = psi.data();
+            m.psi_nr = res.psi_r;
+            m.psi_nmus = res.psi_mu_s;
+        }
+    };
+    const std::size_t main_floats = orders_method ? std::size_t(res.r) * 2u * std::size_t(res.mu) *
+                                                        std::size_t(res.mu_s) * std::size_t(res.nu) * 3u
+                                                  : std::size_t(res.psi_r) * std::size_t(res.psi_mu_s) * 3u;
+    const std::size_t irradiance_floats = std::size_t(res.irradiance_r) * std::size_t(res.irradiance_mu_s) * 3u;
+
+    const std::filesystem::path cache = sky_table_cache_dir();
+    const std::string key = cache.empty() ? std::string() : sky::multiple_tables_key(atmosphere, options);
+    sky::CachedTables cached;
+    if (!cache.empty() && sky::load_cached_tables(cache, key, main_floats, irradiance_floats, cached)) {
+        point_at_main(cached.main);
+        irradiance = std::move(cached.irradiance);
+        multiple_cached = true;
     } else {
-        psi = sky::hillaire_psi_table(atmosphere, res);
-        m.method = sky::kMultipleHillaire;
-        m.psi = psi.data();
-        m.psi_nr = res.psi_r;
-        m.psi_nmus = res.psi_mu_s;
+        const std::uint64_t main_units =
+            orders_method ? sky::ScatteringOrders::progress_units(res, atmosphere.scattering_orders)
+                          : std::uint64_t(res.psi_r) * std::uint64_t(res.psi_mu_s);
+        Progress progress("multiple scattering", main_units + std::uint64_t(res.irradiance_r) *
+                                                                   std::uint64_t(res.irradiance_mu_s));
+        std::vector<float> table =
+            orders_method
+                ? sky::ScatteringOrders::compute(atmosphere, res, atmosphere.scattering_orders, false, &progress)
+                      .residual()
+                : sky::hillaire_psi_table(atmosphere, res, &progress);
+        point_at_main(table);
+        irradiance = sky::sky_irradiance_table(hd, res, options.steps,
+                                               options.uniform_steps ? sky::kStepsUniform : sky::kStepsGraded,
+                                               &progress);
+        progress.finish();
+        if (!cache.empty())
+            sky::store_cached_tables(cache, key, {orders_method ? orders : psi, irradiance});
     }
-    irradiance = sky::sky_irradiance_table(hd, res, options.steps,
-                                           options.uniform_steps ? sky::kStepsUniform : sky::kStepsGraded);
     m.irradiance = irradiance.data();
     m.irr_nr = res.irradiance_r;
     m.irr_nmus = res.irradiance_mu_s;
@@ -162,6 +197,7 @@ glm::dvec3 SkyModel::sky_irradiance(double altitude_km, double cos_sun_zenith) c
 }
 
 double SkyModel::multiple_precompute_seconds() const { return impl_->multiple_seconds; }
+bool SkyModel::multiple_tables_from_cache() const { return impl_->multiple_cached; }
 
 std::size_t SkyModel::multiple_table_bytes() const {
     return (impl_->orders.size() + impl_->psi.size() + impl_->irradiance.size()) * sizeof(float);
