@@ -31,7 +31,9 @@ struct AtmosphereFlags {
         sub.add_option("--table-rule", table_rule,
                        "Shell density rule of the tables: as-published (or seed) or refined (default: the atmosphere's own)");
         sub.add_option("--scattering", scattering,
-                       "single (seed 000) or multiple (every order, ground bounces included); default: the atmosphere's own, single for the presets");
+                       "single (seed 000) or multiple (every order, ground bounces included; its tables take seconds once, then "
+                       "come from the cache in $SKYBAKE_CACHE_DIR, else $XDG_CACHE_HOME/skybake or ~/.cache/skybake; "
+                       "SKYBAKE_CACHE_DIR=off disables it); default: the atmosphere's own, single for the presets");
         sub.add_option("--multiple-method", multiple_method,
                        "With --scattering multiple: orders (Bruneton 2017's precomputed orders, default) or hillaire (Hillaire 2020's table, faster)");
         sub.add_option("--scattering-orders", scattering_orders,

@@ -2,10 +2,13 @@
 // scattering and against each other, Hillaire's table against the orders,
 // the sky irradiance, files and determinism.
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "skybake/error.h"
+#include "skybake/progress.h"
 #include "skybake/sky.h"
 #include "sky/internal.h"
 #include "sky/scattering_orders.h"
@@ -316,6 +319,41 @@ TEST(MultipleScattering, BadSettingsNameTheirField) {
         FAIL();
     } catch (const Error& e) {
         EXPECT_EQ(e.where(), "multiple.sphere");
+    }
+}
+
+// The precomputation reports its progress (a bar on a terminal, or the
+// installed callback): ordered events of one operation that end at its total.
+TEST(MultipleScattering, PrecomputationReportsItsProgress) {
+    for (MultipleScatteringMethod method : {MultipleScatteringMethod::Orders, MultipleScatteringMethod::Hillaire}) {
+        std::vector<ProgressEvent> seen;
+        std::vector<std::string> labels;
+        const ProgressCallback previous = set_progress_callback([&](const ProgressEvent& e) {
+            seen.push_back(e);
+            labels.emplace_back(e.label);
+        });
+        SkyModelOptions o;
+        o.multiple = test_resolution();
+        try {
+            const SkyModel model(earth_multiple(method, 3), o);
+        } catch (...) {
+            set_progress_callback(previous);
+            throw;
+        }
+        set_progress_callback(previous);
+        const char* name = multiple_scattering_method_name(method);
+        ASSERT_FALSE(seen.empty()) << name;
+        EXPECT_TRUE(seen.back().finished) << name;
+        EXPECT_GT(seen.back().total, 0u) << name;
+        EXPECT_EQ(seen.back().done, seen.back().total) << name;
+        for (std::size_t i = 0; i < seen.size(); ++i) {
+            EXPECT_EQ(labels[i], "multiple scattering") << name;
+            EXPECT_EQ(seen[i].total, seen.back().total) << name;
+            EXPECT_LE(seen[i].done, seen[i].total) << name;
+            if (i > 0)
+                EXPECT_GE(seen[i].done, seen[i - 1].done) << name;
+            EXPECT_EQ(seen[i].finished, i + 1 == seen.size()) << name;
+        }
     }
 }
 
