@@ -88,6 +88,10 @@ TEST(PrtCli, BakeRelightPlyAndPng) {
     r = run_cli({"prt", "export", out, "--order", "2", "-o", dir + "/x.glsl"});
     expect_refused(r, 2, "--order");
     EXPECT_FALSE(fs::exists(dir + "/x.glsl"));
+    // A name that would break the shader, as sky export refuses it.
+    r = run_cli({"prt", "export", out, "--name", "x(); } evil {", "-o", dir + "/x.glsl"});
+    expect_refused(r, 2, "--name");
+    EXPECT_FALSE(fs::exists(dir + "/x.glsl"));
 }
 
 TEST(PrtCli, BadInput) {

@@ -30,9 +30,14 @@ void add_prt_export(CLI::App& group) {
         ->check(real_in(0.0, 10000.0, "", End::Open));
     sub->add_option("--nodes", o->nodes, "Nodes in cos θ of the Phong rule (default: order/2 + 1)")
         ->check(integer_in(1, 64));
-    sub->add_option("--name", o->function, "Function name prefix")->capture_default_str();
+    sub->add_option("--name", o->function, "Function name prefix (letters, digits and _)")->capture_default_str();
     sub->callback([o, sub] {
         check_output_path(o->output, {".glsl", ".vert", ".frag", ".txt"}, "--output");
+        if (!valid_shader_identifier(o->function))
+            throw UsageError(fmt::format("'{}' is not a valid function name prefix (letters, digits and _, not "
+                                         "starting with a digit or gl_)",
+                                         o->function),
+                             "--name");
         if (o->model.empty() != (o->glossy == 0.0))
             throw UsageError("--model and --glossy go together", o->model.empty() ? "--glossy" : "--model");
         if (o->model.empty())

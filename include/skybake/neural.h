@@ -300,6 +300,9 @@ struct ShaderExportOptions {
     std::string block_name = "SkybakeSkyWeights"; // a valid identifier
 };
 std::string export_neural_sky(const NeuralSky& net, ExportLanguage language, const ShaderExportOptions& options);
+// Whether `name` can name a function or block in every exported language:
+// 1 to 64 letters, digits and '_', not starting with a digit or "gl_".
+bool valid_shader_identifier(const std::string& name);
 // The contents of that uniform block: 4 * K floats (K vec4s, zero-padded).
 std::vector<float> neural_sky_uniform_data(const NeuralSky& net);
 

@@ -58,7 +58,9 @@ std::string lit(float v, const Dialect& d) {
     return s + d.suffix;
 }
 
-bool valid_identifier(const std::string& s) {
+} // namespace
+
+bool valid_shader_identifier(const std::string& s) {
     if (s.empty() || s.size() > 64 || std::isdigit(static_cast<unsigned char>(s[0])))
         return false;
     for (char c : s)
@@ -66,8 +68,6 @@ bool valid_identifier(const std::string& s) {
             return false;
     return s.rfind("gl_", 0) != 0;
 }
-
-} // namespace
 
 std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const std::string& name) {
     ShaderExportOptions options;
@@ -211,9 +211,9 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const S
     const std::string& name = options.function_name;
     net.validate("neural sky");
     const bool ubo = options.uniform_block && lang == ExportLanguage::Glsl;
-    if (ubo && !valid_identifier(options.block_name))
+    if (ubo && !valid_shader_identifier(options.block_name))
         throw Error(fmt::format("'{}' is not a valid uniform block name", options.block_name), "block_name");
-    if (!valid_identifier(name))
+    if (!valid_shader_identifier(name))
         throw Error(fmt::format("'{}' is not a valid function name (letters, digits and _, not starting with a digit "
                                 "or gl_)",
                                 name),

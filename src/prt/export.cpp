@@ -29,6 +29,11 @@ std::string export_prt_glsl(int order, int channels, const PrtShaderOptions& o) 
     if (o.phong && o.phong->kind != RuleKind::Phong)
         throw Error(fmt::format("'{}' is not a Phong rule", o.phong->spec), "phong");
     const std::string& name = o.function_name;
+    if (!valid_shader_identifier(name))
+        throw Error(fmt::format("'{}' is not a valid function name prefix (letters, digits and _, not starting with "
+                                "a digit or gl_)",
+                                name),
+                    "name");
     const int nc = sh_count(order);
     const int attrs = (channels * nc + 3) / 4;
     const char* lane = "xyzw";

@@ -98,5 +98,20 @@ TEST(PrtExport, BadOptions) {
               std::string::npos);
 }
 
+TEST(PrtExport, RefusesNamesThatAreNotIdentifiers) {
+    PrtShaderOptions o;
+    for (const char* bad : {"x(); } evil {", "", "2d", "gl_prt", "a b", "a-b"}) {
+        o.function_name = bad;
+        try {
+            (void)export_prt_glsl(3, 1, o);
+            ADD_FAILURE() << "accepted '" << bad << "'";
+        } catch (const Error& e) {
+            EXPECT_EQ(e.where(), "name") << bad;
+        }
+    }
+    o.function_name = "My_prt2";
+    EXPECT_NE(export_prt_glsl(1, 1, o).find("vec3 My_prt2_diffuse("), std::string::npos);
+}
+
 } // namespace
 } // namespace skybake
