@@ -95,10 +95,27 @@ TEST(TextureCli, BadInputsGiveOneLineAndWriteNothing) {
     expect_one_line_and_nothing_written(
         run_cli({"ao", (dir / "tiled.ply").string(), "-o", (dir / "out.glb").string(), "--texture", "64"}), dir,
         "outside [0, 1]");
-    // A texture size out of range.
-    const fs::path in = truck("texture-cli-size");
+    // UVs that cover nothing: every vertex at the same UV.
+    std::ofstream(dir / "flat_uv.ply") << "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                          "property float y\nproperty float z\nproperty float s\nproperty float t\n"
+                                          "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                                          "0 0 0 0.5 0.5\n1 0 0 0.5 0.5\n0 1 0 0.5 0.5\n3 0 1 2\n";
     expect_one_line_and_nothing_written(
-        run_cli({"ao", in.string(), "-o", (dir / "out.glb").string(), "--texture", "8"}), dir, "--texture");
-    expect_one_line_and_nothing_written(
-        run_cli({"ao", in.string(), "-o", (dir / "out.glb").string(), "--texture", "100000"}), dir, "--texture");
+        run_cli({"ao", (dir / "flat_uv.ply").string(), "-o", (dir / "out.glb").string(), "--texture", "64"}), dir,
+        "covers no texel");
+}
+
+// A texture size out of range, 0 included, is a usage error (exit 2) that
+// names the flag, before any file is read.
+TEST(TextureCli, SizesOutOfRangeAreUsageErrors) {
+    const fs::path dir = skybake::test::temp_dir("texture-cli-size");
+    const fs::path in = truck("texture-cli-size-in");
+    for (const char* size : {"0", "8", "15", "16385", "99999", "-64"}) {
+        const auto r = run_cli({"ao", in.string(), "-o", (dir / "out.glb").string(), "--texture", size});
+        EXPECT_EQ(r.exit_code, 2) << size << ": " << r.err;
+        EXPECT_EQ(r.err_lines(), 1) << r.err;
+        EXPECT_NE(r.err.find("--texture"), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(dir / "out.glb"));
+        EXPECT_FALSE(fs::exists(dir / "out_ao.png"));
+    }
 }

@@ -540,8 +540,9 @@ void add_ao_bake(CLI::App& group) {
         ->check(real_in(-90.0, 90.0, "degrees"))
         ->capture_default_str();
     sub->add_option("--texture", o->texture,
-                    "Also bake AO into a texture of this many texels square over the mesh's UVs (16 to 16384), "
-                    "wired as the glTF material's occlusionTexture");
+                    "Also bake AO into a texture of this many texels square over the mesh's UVs, wired as the "
+                    "glTF material's occlusionTexture")
+        ->check(integer_in(kMinTextureSize, kMaxTextureSize, "texels"));
     sub->add_option("--uv", o->uv, "UV set (TEXCOORD_n) of the texture bake")
         ->check(integer_in(0, 7))
         ->capture_default_str();

@@ -26,8 +26,11 @@ namespace skybake {
 
 // [SECTION] Sample points of a UV layout ----------------------------------------------
 
+// The texture sizes a bake accepts, texels on a side.
+inline constexpr int kMinTextureSize = 16, kMaxTextureSize = 16384;
+
 struct TextureBakeOptions {
-    int texture_size = 2048; // width and height in texels, 16 to 16384
+    int texture_size = 2048; // width and height in texels, kMinTextureSize to kMaxTextureSize
     int uv_set = 0;          // Mesh::texcoords index (glTF TEXCOORD_n)
     int dilate_texels = 8;   // gutter grown around every UV island, texels, 0 to 256
 };

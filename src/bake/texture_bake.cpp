@@ -24,7 +24,7 @@ namespace skybake {
 
 namespace {
 
-constexpr int kMinSize = 16, kMaxSize = 16384, kMaxDilate = 256;
+constexpr int kMinSize = kMinTextureSize, kMaxSize = kMaxTextureSize, kMaxDilate = 256;
 constexpr float kNoTriangle = std::numeric_limits<float>::infinity();
 
 double cross2(glm::dvec2 a, glm::dvec2 b) {
@@ -149,6 +149,11 @@ TexelSamples texel_samples(const Mesh& mesh, const TextureBakeOptions& options) 
         out.texels.push_back(std::uint32_t(k));
         out.overlapping_texels += inside[k] > 1;
     }
+    if (out.texels.empty())
+        throw Error(fmt::format("UV set {} covers no texel: every triangle's UV footprint has zero area, so the "
+                                "texture would stay blank; unwrap the mesh (for example Smart UV Project in Blender)",
+                                options.uv_set),
+                    "uv_set");
     for (std::uint8_t o : triangle_overlaps)
         out.overlapping_triangles += o;
     const std::size_t n = out.texels.size();
