@@ -5,7 +5,8 @@
 #
 #   scripts/gpu-check.sh pack [BUILD]      here: .gpu/skybake-gpu.tar.xz from BUILD (default build/)
 #   scripts/gpu-check.sh run               there, in the repository root: OUT must name the output folder
-#   scripts/gpu-check.sh --dry-run [BUILD] here: pack, then run against the CPU build, GPU steps skipped
+#   scripts/gpu-check.sh --dry-run [--no-pack] [BUILD]  here: pack (unless --no-pack), then run against
+#                                          the CPU build, GPU steps skipped (OUT default out/gpu-check-dry)
 #   scripts/gpu-check.sh --selftest [BUILD] here, cheap: the lists below against the build and the tests
 #
 # docs/gpu-check.md says how to use it. The whole run keeps within
@@ -60,7 +61,7 @@ die() {
   exit 1
 }
 usage() {
-  sed -n '5,8p' "$0" | sed 's/^# \{0,1\}//' >&2
+  sed -n '5,9p' "$0" | sed 's/^# \{0,1\}//' >&2
   exit 2
 }
 abs_build() {
@@ -154,7 +155,7 @@ cmd_pack() {
   local have=1 d
   for d in "${gl_debs[@]}"; do compgen -G "$gpu/debs/${d}_*.deb" >/dev/null || have=0; done
   if [ $have = 0 ]; then
-    (cd "$gpu/debs" && apt-get download "${gl_debs[@]}" >/dev/null) ||
+    (cd "$gpu/debs" && apt-get download "${gl_debs[@]}" 2>&1 | grep -v 'unsandboxed' >&2) ||
       die "apt-get download ${gl_debs[*]} failed (put the .debs in .gpu/debs by hand)"
   fi
   for d in "${gl_debs[@]}"; do cp "$gpu/debs/${d}"_*.deb "$stage/debs/"; done
@@ -221,6 +222,7 @@ step() {
   local t=$SECONDS rc
   echo "== $name (timeout ${limit} s)"
   {
+    env | grep -E '^(CUDA_LAUNCH_BLOCKING|SKYBAKE_REQUIRE_GPU)=' | sed 's/^/# /'
     echo "\$ $*"
     timeout -k 10 "$limit" "$@"
   } >"$log/$name.log" 2>&1
@@ -450,11 +452,14 @@ cmd_run() {
     ctest_step ctest-gpu-skips 60 any -L gpu -j 2
     if [ -n "$ctest" ]; then
       local before=$failed
+      local n=${#results[@]}
       if SKYBAKE_REQUIRE_GPU=1 ctest_step dry-rerun-path 30 any -R '^core\.CudaDevice\.KernelRuns$'; then
         note "  (unexpected)" "passed without a GPU"
         before=1
-      elif grep -q 'SKYBAKE_REQUIRE_GPU is set' "$log/dry-rerun-path-rerun.log" 2>/dev/null; then
-        note "  (as planned)" "SKYBAKE_REQUIRE_GPU=1 failed it, rerun with CUDA_LAUNCH_BLOCKING=1"
+      elif grep -q 'SKYBAKE_REQUIRE_GPU is set' "$log/dry-rerun-path-rerun.log" 2>/dev/null &&
+        grep -q 'CUDA_LAUNCH_BLOCKING' "$log/dry-rerun-path-rerun.log"; then
+        results=("${results[@]:0:$n}") # the two planned failures, as one line
+        record dry-rerun-path "ok: failed with SKYBAKE_REQUIRE_GPU=1, rerun" 0
       else
         note "  (unexpected)" "no rerun log"
         before=1
@@ -467,16 +472,19 @@ cmd_run() {
   else
     # llvmpipe: the GL tests take minutes on two cores; list them, and run the raster backend's.
     ctest_step ctest-gl-list 30 any -N -L gl
-    ctest_step ctest-gl-raster 120 any -L gl -R 'RasterBake' -j 2
+    ctest_step ctest-gl-raster 60 any -L gl -R \
+      'RasterBake\.(OneTriangleSeesItsWholeHemisphere|VertexInsideAClosedMeshSeesNothing|RefusesWhatItCannotDo)$' -j 2
   fi
 
   # compute-sanitizer. Inputs: a 2,000-triangle city, 4,096 sky samples.
   step inputs 60 any bash -c "'$B' -q mesh generate --kind city --triangles 2000 -o '$W/city2k.glb' &&
     '$B' -q mesh generate --kind city --triangles 3000 -o '$W/city3k.glb' &&
     '$B' -q mesh generate --kind terrain --triangles 100000 -o '$W/terrain100k.glb' &&
-    awk 'BEGIN { print \"cos_view_zenith,cos_view_sun,cos_sun_zenith,density\";
-      for (i = 0; i < 4096; i++) printf \"%.6f,%.6f,%.6f,%.3f\n\", -1 + 2 * ((i * 37) % 4096) / 4095,
-        -1 + 2 * ((i * 101) % 4096) / 4095, -0.2 + 1.2 * ((i * 211) % 4096) / 4095, 0.25 + 0.75 * (i % 4) / 3 }' >'$W/sky.csv'"
+    awk 'BEGIN { print \"cos_view_zenith,cos_view_sun,cos_sun_zenith,density\"; pi = atan2(0, -1);
+      for (i = 0; i < 4096; i++) { v = pi * ((i * 37) % 4096) / 4096; s = 0.6 * pi * ((i * 101) % 4096) / 4096;
+        p = 2 * pi * ((i * 211) % 4096) / 4096;
+        printf \"%.6f,%.6f,%.6f,%.3f\n\", cos(v), cos(v) * cos(s) + sin(v) * sin(s) * cos(p), cos(s),
+          0.25 + 0.75 * (i % 4) / 3 } }' >'$W/sky.csv'"
   local cs=(timeout 120 "$sanitizer" --error-exitcode 1 --print-limit 20)
   local ao=("$B" -q ao "$W/city2k.glb" --device cuda --rule lebedev:110+rotate)
   local m
@@ -549,7 +557,7 @@ sanitize() {
   local cmd=("${args[@]:$i}") rc
   "${cmd[@]}" >"$log/$name.log" 2>&1
   rc=$?
-  if [ $rc -eq 1 ] && grep -qi 'cuda' "$log/$name.log"; then
+  if [ $rc -eq 1 ] && grep -q 'no usable CUDA device\|no CUDA device' "$log/$name.log"; then
     record "$name" "skipped (dry run: needs the GPU); flags ok" 0
   else
     record "$name" "FAIL: exit $rc without a device (see $name.log)" 0
@@ -664,7 +672,11 @@ case "${1:-}" in
   --dry-run)
     shift
     t0=$SECONDS
-    cmd_pack "$@" || exit 1
+    if [ "${1:-}" = --no-pack ]; then
+      shift
+    else
+      cmd_pack "$@" || exit 1
+    fi
     OUT=${OUT:-$root/out/gpu-check-dry} cmd_run dry
     rc=$?
     echo "dry run, pack included: $((SECONDS - t0)) s"
