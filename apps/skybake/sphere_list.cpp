@@ -25,6 +25,8 @@ const Family kFamilies[] = {
 
 std::vector<int> cached_designs() {
     std::vector<int> ts;
+    if (design_cache_dir().empty()) // the cache is off
+        return ts;
     for (int t = 1; t <= 40; ++t) {
         std::error_code ec;
         if (std::filesystem::exists(design_cache_dir() / ("design-v1-t" + std::to_string(t) + ".txt"), ec))
@@ -62,7 +64,8 @@ void run(bool json) {
     std::string list;
     for (int t : cached)
         list += fmt::format("{}{}", list.empty() ? "" : ", ", t);
-    fmt::print("\nDesign cache: {} (cached t: {})\n", design_cache_dir().string(), list.empty() ? "none" : list);
+    const std::string dir = design_cache_dir().empty() ? std::string("off") : design_cache_dir().string();
+    fmt::print("\nDesign cache: {} (cached t: {})\n", dir, list.empty() ? "none" : list);
 }
 
 } // namespace

@@ -52,4 +52,12 @@ private:
 // larger than max_bytes.
 std::string read_file(const std::filesystem::path& path, std::uint64_t max_bytes = std::uint64_t(1) << 32);
 
+// The folder of skybake's on-disk caches (multiple-scattering tables,
+// spherical designs): $SKYBAKE_CACHE_DIR when set and not empty ("off",
+// "none" or "0": no cache, nothing read or written), else
+// $XDG_CACHE_HOME/skybake (an absolute XDG_CACHE_HOME; the XDG spec ignores a
+// relative one), else $HOME/.cache/skybake. Empty when disabled, or without
+// HOME. Read again at each call. The folder is created on the first write.
+std::filesystem::path cache_dir();
+
 } // namespace skybake

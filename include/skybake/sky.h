@@ -297,11 +297,9 @@ struct MultipleScatteringResolution {
     double mu_s_min = -0.2; // lowest sun cosine of the orders grid (Bruneton: cos 102°), in (−1, 0]
 };
 
-// The folder of the table cache: $SKYBAKE_CACHE_DIR when set and not empty
-// ("off", "none" or "0": no cache, nothing read or written), else
-// $XDG_CACHE_HOME/skybake (an absolute XDG_CACHE_HOME), else
-// $HOME/.cache/skybake; empty (no cache) without HOME. Read at each SkyModel
-// construction.
+// The folder of the table cache: skybake::cache_dir() (skybake/files.h):
+// $SKYBAKE_CACHE_DIR ("off" disables the cache), else $XDG_CACHE_HOME/skybake,
+// else ~/.cache/skybake; empty when disabled. Read at each SkyModel construction.
 std::filesystem::path sky_table_cache_dir();
 
 struct SkyModelOptions {

@@ -165,8 +165,10 @@ glm::dmat3 vertex_rotation(std::uint32_t vertex, std::uint64_t seed);
 // design_point_count(t) ≈ t²/2 + t/2 (234 for t = 21, where Hardin & Sloane list
 // 240), or a few more if the optimiser needed slack to leave a local minimum.
 //
-// Computed designs are cached as text files in design_cache_dir(): the folder in
-// $SKYBAKE_CACHE_DIR if set, else $XDG_CACHE_HOME/skybake, else ~/.cache/skybake.
+// Computed designs are cached as text files in design_cache_dir(), which is
+// skybake::cache_dir() (skybake/files.h): the folder in $SKYBAKE_CACHE_DIR if
+// set ("off": no disk cache, designs are kept in memory only), else
+// $XDG_CACHE_HOME/skybake, else ~/.cache/skybake.
 // Files are written atomically, and checked again when read (a stale or damaged
 // file is recomputed).
 // The smallest point count the optimiser tries for strength t (even, 2 for t = 1).

@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <random>
@@ -114,6 +115,20 @@ void OutputSet::commit() {
     if (!failed.empty())
         throw Error(failed, failed_target);
     staged_.clear();
+}
+
+fs::path cache_dir() {
+    if (const char* own = std::getenv("SKYBAKE_CACHE_DIR"); own && *own) {
+        const std::string v(own);
+        if (v == "off" || v == "none" || v == "0")
+            return {};
+        return fs::path(v);
+    }
+    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg && fs::path(xdg).is_absolute())
+        return fs::path(xdg) / "skybake";
+    if (const char* home = std::getenv("HOME"); home && *home)
+        return fs::path(home) / ".cache" / "skybake";
+    return {};
 }
 
 std::string read_file(const fs::path& path, std::uint64_t max_bytes) {

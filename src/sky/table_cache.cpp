@@ -3,7 +3,6 @@
 
 #include <bit>
 #include <cstdint>
-#include <cstdlib>
 #include <cstring>
 #include <fstream>
 
@@ -17,23 +16,7 @@ namespace skybake {
 
 namespace fs = std::filesystem;
 
-fs::path sky_table_cache_dir() {
-    const char* own = std::getenv("SKYBAKE_CACHE_DIR");
-    if (own && *own) {
-        const std::string v(own);
-        if (v == "off" || v == "0" || v == "none")
-            return {};
-        return fs::path(v);
-    }
-    // XDG Base Directory: a relative $XDG_CACHE_HOME is invalid and ignored.
-    const char* xdg = std::getenv("XDG_CACHE_HOME");
-    if (xdg && *xdg && fs::path(xdg).is_absolute())
-        return fs::path(xdg) / "skybake";
-    const char* home = std::getenv("HOME");
-    if (home && *home)
-        return fs::path(home) / ".cache" / "skybake";
-    return {};
-}
+fs::path sky_table_cache_dir() { return cache_dir(); }
 
 namespace sky {
 

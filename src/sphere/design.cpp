@@ -177,6 +177,8 @@ std::filesystem::path cache_file(int t) {
 
 // Reads a cached design; returns false when the file is missing, damaged or not a design.
 bool load_cached(int t, SphereRule& out) {
+    if (design_cache_dir().empty()) // the cache is off
+        return false;
     const std::filesystem::path path = cache_file(t);
     std::ifstream in(path);
     if (!in)
@@ -201,6 +203,8 @@ bool load_cached(int t, SphereRule& out) {
 }
 
 void store_cached(int t, const SphereRule& rule, double residual) {
+    if (design_cache_dir().empty())
+        return;
     try {
         const std::filesystem::path path = cache_file(t);
         std::filesystem::create_directories(path.parent_path());
@@ -225,15 +229,7 @@ int design_point_count(int t) {
     return e == 0 ? 2 : 2 * ((e + 3 + 1) / 2);
 }
 
-std::filesystem::path design_cache_dir() {
-    if (const char* dir = std::getenv("SKYBAKE_CACHE_DIR"); dir && *dir)
-        return std::filesystem::path(dir);
-    if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
-        return std::filesystem::path(xdg) / "skybake";
-    if (const char* home = std::getenv("HOME"); home && *home)
-        return std::filesystem::path(home) / ".cache" / "skybake";
-    return std::filesystem::temp_directory_path() / "skybake-cache";
-}
+std::filesystem::path design_cache_dir() { return cache_dir(); }
 
 double design_residual(const SphereRule& rule, int t) {
     const int count = sh_count(t);

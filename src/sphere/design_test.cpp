@@ -86,3 +86,26 @@ TEST(Design, CacheIsWrittenAndADamagedFileIsRecomputed) {
     // And the memory cache returns the same rule.
     EXPECT_EQ(design_rule(6).points, r6.points);
 }
+
+// SKYBAKE_CACHE_DIR=off (as the test suite sets it) keeps designs in memory:
+// no folder named "off", nothing read or written.
+TEST(Design, CacheOffWritesNothing) {
+    const char* old = std::getenv("SKYBAKE_CACHE_DIR");
+    const std::string keep = old ? old : "";
+    const std::filesystem::path here =
+        std::filesystem::temp_directory_path() / ("skybake-design-off-" + std::to_string(::getpid()));
+    std::filesystem::create_directories(here);
+    const std::filesystem::path cwd = std::filesystem::current_path();
+    std::filesystem::current_path(here);
+    ::setenv("SKYBAKE_CACHE_DIR", "off", 1);
+    EXPECT_TRUE(design_cache_dir().empty());
+    const SphereRule r = design_rule(5);
+    EXPECT_LE(design_residual(r, 5), 1e-10);
+    EXPECT_TRUE(std::filesystem::is_empty(here));
+    std::filesystem::current_path(cwd);
+    std::filesystem::remove_all(here);
+    if (old)
+        ::setenv("SKYBAKE_CACHE_DIR", keep.c_str(), 1);
+    else
+        ::unsetenv("SKYBAKE_CACHE_DIR");
+}
