@@ -12,6 +12,8 @@
 # docs/gpu-check.md says how to use it. The whole run keeps within
 # GPU_CHECK_BUDGET_S seconds (default 450): each step's timeout is cut to what
 # is left, and a step that would start with under 5 s left is skipped.
+# GPU_CHECK_ONLY / GPU_CHECK_SKIP: regexes of the step names to run / to leave
+# out (a second call that reruns only what failed); `device` and `inputs` always run.
 set -uo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -132,7 +134,7 @@ cmd_pack() {
     [ -e "$inc" ] || continue
     exe=${inc%\[1\]_include.cmake}
     f=${inc#"$build"/}
-    if printf '%s\n' "${bins[@]}" | grep -qx "${exe#"$build"/}"; then
+    if grep -qx "${exe#"$build"/}" <<<"$(printf '%s\n' "${bins[@]}")"; then
       # Only the list: no re-discovery there (it would need CMake 3.25's modules).
       [ -s "${exe}[1]_tests.cmake" ] || die "no test list ${exe}[1]_tests.cmake (run ctest -N in $build)"
       cp "${exe}[1]_tests.cmake" "$stage/build/${f%_include.cmake}_tests.cmake"
@@ -209,6 +211,12 @@ step() {
   shift 3
   local left
   left=$(remaining)
+  if [ "$name" != device ] && [ "$name" != inputs ] &&
+    { { [ -n "${GPU_CHECK_ONLY:-}" ] && ! [[ "$name" =~ $GPU_CHECK_ONLY ]]; } ||
+      { [ -n "${GPU_CHECK_SKIP:-}" ] && [[ "$name" =~ $GPU_CHECK_SKIP ]]; }; }; then
+    record "$name" "skipped (GPU_CHECK_ONLY / GPU_CHECK_SKIP)" 0
+    return 0
+  fi
   if [ "$class" = gpu ] && [ "$mode" = dry ]; then
     record "$name" "skipped (dry run: needs the GPU)" 0
     return 0
@@ -263,9 +271,11 @@ setup_libs() {
     # Here every library is on the system: use all packed ones, so the dry run tests them.
     ln -s "$pkg"/lib/* "$use"/
   else
+    local cache
+    cache=$(ldconfig -p)
     for f in "$pkg"/lib/*; do
       name=${f##*/}
-      ldconfig -p | grep -q "^[[:space:]]*$name " || ln -s "$f" "$use/$name"
+      grep -q "^[[:space:]]*$name " <<<"$cache" || ln -s "$f" "$use/$name"
     done
   fi
   export LD_LIBRARY_PATH=$use${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
@@ -293,7 +303,7 @@ setup_egl() {
     local d
     for d in "$pkg"/debs/*.deb; do dpkg -x "$d" / || return 1; done
     ldconfig
-    if ! ldconfig -p | grep -q libEGL_nvidia; then
+    if ! grep -q libEGL_nvidia <<<"$(ldconfig -p)"; then
       for d in /usr/local/nvidia/lib64 /usr/local/nvidia/lib; do
         [ -d "$d" ] && export LD_LIBRARY_PATH=$LD_LIBRARY_PATH:$d
       done
@@ -384,19 +394,30 @@ ctest_step() {
   local rc=$?
   [ $rc -ne 0 ] && [ $rc -ne 124 ] && [ $rc -ne 137 ] || return $rc
   [ -n "$ctest" ] || return $rc
-  CUDA_LAUNCH_BLOCKING=1 step "$name-rerun" 120 "$class" "$ctest" --test-dir "$pkg/build" --rerun-failed \
+  CUDA_LAUNCH_BLOCKING=1 step "$name-rerun" 45 "$class" "$ctest" --test-dir "$pkg/build" --rerun-failed \
     --output-on-failure -V
   return $rc
 }
 
-# Without ctest: the label's executables, straight (all their tests have the label).
+# Without ctest: the label's executables, straight (all their tests have the
+# label); -R / -E are matched against the tests' prefix ("bake.", "e2e.").
 gtest_direct() {
-  local label="" rc=0 exe
+  local label="" only="" leave="" rc=0 exe prefix
   while [ $# -gt 0 ]; do
-    case $1 in -L) label=$2; shift 2 ;; *) shift ;; esac
+    case $1 in
+      -L) label=$2; shift 2 ;;
+      -R) only=$2; shift 2 ;;
+      -E) leave=$2; shift 2 ;;
+      *) shift ;;
+    esac
   done
-  for exe in $(cd "$pkg/build" && test_executables "$pkg/build" | grep "_${label}_tests$"); do
-    (cd "$pkg/build/$(dirname "$exe")" && "./${exe##*/}") || rc=1
+  for exe in $(test_executables "$pkg/build" | grep "_${label}_tests$"); do
+    prefix=${exe##*/}
+    prefix=${prefix%%_*}.
+    [ -z "$only" ] || [[ "$prefix" =~ $only ]] || continue
+    [ -z "$leave" ] || ! [[ "$prefix" =~ $leave ]] || continue
+    echo "== $exe"
+    (cd "$pkg/build/$(dirname "$exe")" && "./${exe##*/}" --gtest_output="xml:$log/gtest-${exe##*/}.xml") || rc=1
   done
   return $rc
 }
@@ -426,8 +447,8 @@ cmd_run() {
   record unpack ok $((SECONDS - t))
   t=$SECONDS
   setup_layout || die "cannot lay out the build tree (see above)"
-  setup_libs || note libraries "some are missing (see $log/device.log)"
   setup_egl || die "cannot unpack the GL loaders"
+  setup_libs || note libraries "some are missing (see $log/device.log)"
   export SKYBAKE_ASSIMP_MODELS=$pkg/models
   export TMPDIR=$work/tmp
   ctest=$(find_tool ctest /opt/torch/.venv/bin/ctest /usr/local/bin/ctest ||
@@ -446,8 +467,8 @@ cmd_run() {
   # Tests. Dry run: the GPU tests skip themselves (no SKYBAKE_REQUIRE_GPU), which
   # checks the packed tree; the rerun path is exercised on one test that fails.
   if [ "$mode" = device ]; then
-    SKYBAKE_REQUIRE_GPU=1 ctest_step ctest-gpu 200 gpu -L gpu -E '^e2e\.' -j 4
-    SKYBAKE_REQUIRE_GPU=1 ctest_step ctest-gpu-cli 90 gpu -L gpu -R '^e2e\.' -j 2
+    SKYBAKE_REQUIRE_GPU=1 ctest_step ctest-gpu 150 gpu -L gpu -E '^e2e\.' -j 4
+    SKYBAKE_REQUIRE_GPU=1 ctest_step ctest-gpu-cli 60 gpu -L gpu -R '^e2e\.' -j 2
   else
     ctest_step ctest-gpu-skips 60 any -L gpu -j 2
     if [ -n "$ctest" ]; then
@@ -468,7 +489,7 @@ cmd_run() {
     fi
   fi
   if [ "$mode" = device ]; then
-    ctest_step ctest-gl 150 any -L gl -j 4
+    ctest_step ctest-gl 100 any -L gl -j 4
   else
     # llvmpipe: the GL tests take minutes on two cores; list them, and run the raster backend's.
     ctest_step ctest-gl-list 30 any -N -L gl
@@ -476,7 +497,8 @@ cmd_run() {
       'RasterBake\.(OneTriangleSeesItsWholeHemisphere|VertexInsideAClosedMeshSeesNothing|RefusesWhatItCannotDo)$' -j 2
   fi
 
-  # compute-sanitizer. Inputs: a 2,000-triangle city, 4,096 sky samples.
+  # Inputs: meshes (2,000 triangles for compute-sanitizer, the 3k table case,
+  # the viewer's 100k terrain) and 4,096 sky samples.
   step inputs 60 any bash -c "'$B' -q mesh generate --kind city --triangles 2000 -o '$W/city2k.glb' &&
     '$B' -q mesh generate --kind city --triangles 3000 -o '$W/city3k.glb' &&
     '$B' -q mesh generate --kind terrain --triangles 100000 -o '$W/terrain100k.glb' &&
@@ -485,33 +507,14 @@ cmd_run() {
         p = 2 * pi * ((i * 211) % 4096) / 4096;
         printf \"%.6f,%.6f,%.6f,%.3f\n\", cos(v), cos(v) * cos(s) + sin(v) * sin(s) * cos(p), cos(s),
           0.25 + 0.75 * (i % 4) / 3 } }' >'$W/sky.csv'"
-  local cs=(timeout 120 "$sanitizer" --error-exitcode 1 --print-limit 20)
-  local ao=("$B" -q ao "$W/city2k.glb" --device cuda --rule lebedev:110+rotate)
-  local m
-  for m in bvh per-vertex per-polygon; do
-    sanitize "memcheck-ao-$m" "${cs[@]}" --tool memcheck "${ao[@]}" --method $m --bits "$W/$m.bits" -o "$W/$m.glb"
-  done
-  sanitize memcheck-sky-eval "${cs[@]}" --tool memcheck "$B" -q sky eval --preset earth --input "$W/sky.csv" \
-    --output "$W/eval.csv" --device cuda
-  sanitize memcheck-sky-eval-network "${cs[@]}" --tool memcheck "$B" -q sky eval --model "$net" \
-    --input "$W/sky.csv" --output "$W/eval_net.csv" --device cuda
-  sanitize memcheck-sky-render "${cs[@]}" --tool memcheck "$B" -q sky render --preset earth --altitude-km 0 \
-    --sun-elevation-deg 20 --view panorama --size 512x256 -o "$W/sky.exr" --device cuda
-  sanitize memcheck-sky-render-network "${cs[@]}" --tool memcheck "$B" -q sky render --model "$net" \
-    --altitude-km 0 --sun-elevation-deg 20 --view panorama --size 512x256 -o "$W/sky_net.exr" --device cuda
-  sanitize initcheck-ao-bvh "${cs[@]}" --tool initcheck "${ao[@]}" --method bvh --bits "$W/i.bits" -o "$W/i.glb"
-  sanitize racecheck-ao-per-polygon "${cs[@]}" --tool racecheck "${ao[@]}" --method per-polygon \
-    --bits "$W/r.bits" -o "$W/r.glb"
-  sanitize synccheck-ao-per-polygon "${cs[@]}" --tool synccheck "${ao[@]}" --method per-polygon \
-    --bits "$W/s.bits" -o "$W/s.glb"
-
   # Benchmarks, Google Benchmark JSON. Dry run: each filter must select benchmarks.
   mkdir -p "$log/bench"
   local b n
   for b in "${bench_programs[@]}"; do
     if [ "$mode" = device ]; then
-      step "bench-$b" 120 gpu "$S/$b" --benchmark_filter="${bench_filter[$b]}" \
-        --benchmark_out="$log/bench/$b.json" --benchmark_out_format=json
+      # A benchmark that skipped itself with an error (no device...) fails the step.
+      step "bench-$b" 120 gpu bash -c '"$1" --benchmark_filter="$2" --benchmark_out="$3" --benchmark_out_format=json &&
+        ! grep -q "\"error_occurred\": true" "$3"' bench "$S/$b" "${bench_filter[$b]}" "$log/bench/$b.json"
     else
       n=$("$S/$b" --benchmark_list_tests --benchmark_filter="${bench_filter[$b]}" 2>/dev/null | grep -c .)
       if [ "$n" -gt 0 ]; then
@@ -539,6 +542,27 @@ cmd_run() {
   step shot-raster-bake 90 any "$B" ao "$W/city3k.glb" --backend raster "${raster[@]}" -o "$W/city_raster.glb" \
     --preview "$out/raster_bake.png" --preview-size "$size" --json
 
+
+  # compute-sanitizer, last: the benchmarks and screenshots matter more if time runs short.
+  local cs=(timeout 120 "$sanitizer" --error-exitcode 1 --print-limit 20)
+  local ao=("$B" -q ao "$W/city2k.glb" --device cuda --rule lebedev:110+rotate)
+  local m
+  for m in bvh per-vertex per-polygon; do
+    sanitize "memcheck-ao-$m" "${cs[@]}" --tool memcheck "${ao[@]}" --method $m --bits "$W/$m.bits" -o "$W/$m.glb"
+  done
+  sanitize memcheck-sky-eval "${cs[@]}" --tool memcheck "$B" -q sky eval --preset earth --input "$W/sky.csv" \
+    --output "$W/eval.csv" --device cuda
+  sanitize memcheck-sky-eval-network "${cs[@]}" --tool memcheck "$B" -q sky eval --model "$net" \
+    --input "$W/sky.csv" --output "$W/eval_net.csv" --device cuda
+  sanitize memcheck-sky-render "${cs[@]}" --tool memcheck "$B" -q sky render --preset earth --altitude-km 0 \
+    --sun-elevation-deg 20 --view panorama --size 512x256 -o "$W/sky.exr" --device cuda
+  sanitize memcheck-sky-render-network "${cs[@]}" --tool memcheck "$B" -q sky render --model "$net" \
+    --altitude-km 0 --sun-elevation-deg 20 --view panorama --size 512x256 -o "$W/sky_net.exr" --device cuda
+  sanitize initcheck-ao-bvh "${cs[@]}" --tool initcheck "${ao[@]}" --method bvh --bits "$W/i.bits" -o "$W/i.glb"
+  sanitize racecheck-ao-per-polygon "${cs[@]}" --tool racecheck "${ao[@]}" --method per-polygon \
+    --bits "$W/r.bits" -o "$W/r.glb"
+  sanitize synccheck-ao-per-polygon "${cs[@]}" --tool synccheck "${ao[@]}" --method per-polygon \
+    --bits "$W/s.bits" -o "$W/s.glb"
   summary
 }
 
@@ -625,7 +649,7 @@ cmd_selftest() {
   done
   mapfile -t used < <(printf '%s\n' "${used[@]}" | sort -u | grep .)
   for m in "${used[@]}"; do
-    printf '%s\n' "${models[@]}" | grep -qx "$m" || { echo "selftest: a GPU/GL test reads $m, which is not packed (models=)"; bad=1; }
+    grep -qx "$m" <<<"$(printf '%s\n' "${models[@]}")" || { echo "selftest: a GPU/GL test reads $m, which is not packed (models=)"; bad=1; }
   done
   [ ${#used[@]} -gt 0 ] || { echo "selftest: found no model that the GPU/GL tests read (the scan is broken)"; bad=1; }
   local mdir
@@ -650,7 +674,7 @@ cmd_selftest() {
   local bins=() present=()
   mapfile -t bins < <(packed_binaries "$build")
   for f in "${bins[@]}"; do [ -x "$build/$f" ] && present+=("$build/$f"); done
-  if ldd "${present[@]}" 2>&1 | grep -q 'not found'; then
+  if grep -q 'not found' <<<"$(ldd "${present[@]}" 2>&1)"; then
     echo "selftest: ldd finds no library for:"; ldd "${present[@]}" 2>&1 | grep 'not found' | sort -u; bad=1
   fi
   local libs
