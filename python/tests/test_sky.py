@@ -109,3 +109,28 @@ def test_image_files(tmp):
     png = skybake.load_image(tmp / "a.png")
     assert png.shape == (4, 6, 3)
     np.testing.assert_allclose(png, img, atol=0.01)
+
+
+def test_multiple_scattering_tables_come_from_the_cache(earth, tmp_path, monkeypatch):
+    # The module reads the same on-disk cache as the CLI (docs/sky.md), so the
+    # Blender add-on's skies with multiple scattering pay for their tables once.
+    import json
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("SKYBAKE_CACHE_DIR", str(cache))
+    spec = json.loads(earth.to_json())
+    spec.update(scattering="multiple", multiple_method="hillaire")
+    atmosphere = skybake.Atmosphere.from_json(json.dumps(spec))
+    samples = np.ascontiguousarray(skybake.draw_sky_samples(64, seed=4))
+    first = skybake.Sky.reference(atmosphere).evaluate(samples)
+    files = sorted(p.name for p in cache.iterdir())
+    assert len(files) == 1 and files[0].startswith("multiple-scattering-")
+    second = skybake.Sky.reference(atmosphere).evaluate(samples)
+    assert np.array_equal(first, second)
+    # A damaged file is recomputed: the same answer, the file whole again.
+    path = cache / files[0]
+    whole = path.read_bytes()
+    path.write_bytes(whole[: len(whole) // 2])
+    assert np.array_equal(skybake.Sky.reference(atmosphere).evaluate(samples), first)
+    assert path.read_bytes() == whole
+    monkeypatch.setenv("SKYBAKE_CACHE_DIR", "off")
+    assert np.array_equal(skybake.Sky.reference(atmosphere).evaluate(samples), first)
