@@ -192,9 +192,15 @@ TEST(NeuralCli, ExportEveryFormat) {
 
 TEST(NeuralCli, ErrorReport) {
     const std::string dir = temp_dir("neural_error");
+    ASSERT_FALSE(fs::exists(dir + "/views"));
     auto r = run_cli({"sky", "error", "--model", tiny_model(), "--samples", "2000", "--size", "48x32", "--views-dir",
                       dir + "/views", "--json"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_FALSE(fs::is_empty(dir + "/views")) << "the views folder is created and filled";
+    // A run that fails (no such model) leaves no folder behind.
+    auto bad = run_cli({"sky", "error", "--model", dir + "/missing.json", "--views-dir", dir + "/views2"});
+    EXPECT_EQ(bad.exit_code, 1) << bad.err;
+    EXPECT_FALSE(fs::exists(dir + "/views2"));
     const auto j = nlohmann::json::parse(r.out);
     const auto& rel = j["relative_error"];
     const auto n = rel["all"]["count"].get<int>() + j["night_absolute_error_over_max_n"]["count"].get<int>();

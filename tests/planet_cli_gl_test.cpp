@@ -240,6 +240,40 @@ TEST(PlanetCli, FlyWritesEveryFrame) {
     EXPECT_NE(r.out.find("\"frames\": 4"), std::string::npos) << r.out;
 }
 
+TEST(PlanetCli, FlyCreatesItsOutputFolderAndRemovesItOnFailure) {
+    // A command whose output is a folder creates it (as ao --out-dir does),
+    // in an existing folder; `frames/` with its slash is the same folder.
+    const std::string dir = test::temp_dir("planet_fly_folder");
+    const std::string frames = dir + "/frames/";
+    ASSERT_FALSE(fs::exists(frames));
+    auto r = run_cli({"fly", "--model", kData + "sky_paper.json", "--frames", "2", "--size", "16x12", "-o", frames,
+                      "--strip", frames + "strip.png", "-q"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(frames + "frame_0000.png"));
+    EXPECT_TRUE(fs::exists(frames + "frame_0001.png"));
+    EXPECT_TRUE(fs::exists(frames + "strip.png"));
+    // An existing folder is used as it is.
+    r = run_cli({"fly", "--model", kData + "sky_paper.json", "--frames", "2", "--size", "16x12", "-o", frames, "-q"});
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(files_in_count(dir + "/frames"), 3u);
+    // A missing parent, or a file in the way, is one line and exit 1.
+    r = run_cli({"fly", "--model", kData + "sky_paper.json", "--frames", "2", "--size", "16x12", "-o",
+                 dir + "/missing/frames"});
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(r.err_lines(), 1) << r.err;
+    EXPECT_NE(r.err.find("does not exist"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir + "/missing"));
+    std::ofstream(dir + "/afile") << "x";
+    r = run_cli({"fly", "--model", kData + "sky_paper.json", "--frames", "2", "--size", "16x12", "-o", dir + "/afile"});
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(r.err_lines(), 1) << r.err;
+    // A run that fails after creating the folder takes it away again.
+    r = run_cli({"fly", "--model", dir + "/no-such-model.json", "--frames", "2", "--size", "16x12", "-o",
+                 dir + "/failed"});
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_FALSE(fs::exists(dir + "/failed"));
+}
+
 TEST(PlanetCli, FlyBadPathFileIsOneLineAndNoFrames) {
     const std::string dir = test::temp_dir("planet_fly_bad");
     {

@@ -55,6 +55,7 @@ struct AoOptions {
     int uv = 0;
     std::string texture_out;
     int dilate = 8;
+    bool keep_seams = false;
     bool mpi = false;
     std::string batch, out_dir;
 };
@@ -164,7 +165,7 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
         check_output_path(o.bits, {}, "--bits");
     const std::string texture_out = o.texture_out.empty() ? default_texture_path(o.output) : o.texture_out;
     if (o.texture == 0) {
-        for (const char* f : {"--uv", "--texture-out", "--dilate"})
+        for (const char* f : {"--uv", "--texture-out", "--dilate", "--keep-seams"})
             refuse_if_given(sub, f, "without --texture");
     } else {
         check_output_path(texture_out, {".png", ".exr"}, "--texture-out");
@@ -205,6 +206,7 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
         tb.texture_size = o.texture;
         tb.uv_set = o.uv;
         tb.dilate_texels = o.dilate;
+        tb.stitch_seams = !o.keep_seams;
         if (mesh.normals.empty())
             compute_normals(mesh);
         texture = bake_ao_texture(mesh, rule, *tracer, b, tb);
@@ -309,6 +311,9 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
                             {"overlapping_texels", texture->overlapping_texels},
                             {"overlapping_triangles", texture->overlapping_triangles},
                             {"dilate_texels", o.dilate},
+                            {"seam_edges", texture->seams.seam_edges},
+                            {"seam_mismatch_before_max", texture->seams.mismatch_before_max},
+                            {"seam_mismatch_after_max", texture->seams.mismatch_after_max},
                             {"rays", texture->rays},
                             {"sample_seconds", texture->sample_seconds},
                             {"build_seconds", texture->build_seconds},
@@ -427,11 +432,8 @@ void run_batch(const AoOptions& o, const CLI::App& sub, bool job) {
     if (assets.empty())
         throw Error(fmt::format("{} lists no assets (one path a line; # starts a comment)", o.batch), "--batch");
     const std::filesystem::path dir(o.out_dir);
-    std::error_code ec;
-    if (!std::filesystem::is_directory(dir, ec) && !std::filesystem::create_directory(dir, ec))
-        throw Error(fmt::format("cannot create the output folder {}: {}", o.out_dir,
-                                ec ? ec.message() : std::string("a file of that name is in the way")),
-                    "--out-dir");
+    OutputFolder folder(o.out_dir, "--out-dir");
+    folder.keep(); // each asset's outputs are committed on their own
     std::vector<std::filesystem::path> outputs;
     std::map<std::string, std::size_t> by_output;
     for (std::size_t i = 0; i < assets.size(); ++i) {
@@ -551,6 +553,9 @@ void add_ao_bake(CLI::App& group) {
     sub->add_option("--dilate", o->dilate, "Gutter grown around the UV islands of the texture, texels")
         ->check(integer_in(0, 256, "texels"))
         ->capture_default_str();
+    sub->add_flag("--keep-seams", o->keep_seams,
+                  "Leave the texture as traced along UV seams; by default the texels there are adjusted so that "
+                  "both sides of a seam read the same AO");
     add_json_flag(*sub, o->json);
     sub->add_flag("--mpi", o->mpi,
                   "Run as one rank of an MPI job even when no launcher's variables say so (under mpirun or srun "

@@ -141,6 +141,35 @@ void check_output_path(const std::string& path, std::initializer_list<const char
         throw Error(fmt::format("the output path {} is a folder", path), flag);
 }
 
+OutputFolder::OutputFolder(const std::string& path, const char* flag) : path_(path) {
+    if (path.empty())
+        throw UsageError("the output folder is empty", flag);
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) {
+        check_output_path((fs::path(path) / "probe").string(), {}, flag); // writable
+        return;
+    }
+    fs::path p(path);
+    if (!p.has_filename()) // "frames/": its parent is the folder above
+        p = p.parent_path();
+    check_output_path(p.string(), {}, flag); // an existing, writable parent; not a file in the way
+    if (fs::exists(p, ec))
+        throw Error(fmt::format("the output folder {} is a file", path), flag);
+    if (!fs::create_directory(p, ec))
+        throw Error(fmt::format("cannot create the output folder {}: {}", path,
+                                ec ? ec.message() : std::string("a file of that name is in the way")),
+                    flag);
+    created_ = true;
+}
+
+OutputFolder::~OutputFolder() {
+    if (!created_)
+        return;
+    std::error_code ec;
+    if (fs::is_empty(path_, ec) && !ec)
+        fs::remove(path_, ec);
+}
+
 bool given(const CLI::App& sub, const char* flag) {
     const CLI::Option* o = sub.get_option_no_throw(flag);
     return o && o->count() > 0;

@@ -67,6 +67,25 @@ std::string flag_for_field(const std::string& where);
 // lower case with the dot, e.g. {".glb", ".ply"}; empty accepts any.
 void check_output_path(const std::string& path, std::initializer_list<const char*> extensions, const char* flag);
 
+// An output folder (fly -o, ao --out-dir, sky error --views-dir): a command
+// whose output is a folder creates it. The folder may exist (it must be
+// writable), or be new in an existing, writable folder (exit 1 otherwise, as
+// check_output_path). Checked and created before any work; a folder created
+// here is removed again if the command fails before keep() and it is still
+// empty, so a failure leaves nothing behind.
+class OutputFolder {
+public:
+    OutputFolder(const std::string& path, const char* flag);
+    OutputFolder(const OutputFolder&) = delete;
+    OutputFolder& operator=(const OutputFolder&) = delete;
+    ~OutputFolder();
+    void keep() { created_ = false; }
+
+private:
+    std::string path_;
+    bool created_ = false;
+};
+
 // Lower-case extension with the dot ("" when there is none).
 std::string lower_extension(const std::string& path);
 

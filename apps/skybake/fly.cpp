@@ -142,7 +142,7 @@ void add_fly(CLI::App& sub) {
                    "..., {\"t\": 1, ...}]}")
         ->capture_default_str();
     sub.add_option("--frames", o->frames, "Number of frames")->check(integer_in(2, 100000))->capture_default_str();
-    sub.add_option("-o,--output", o->output, "Existing folder for frame_0000.png, frame_0001.png, ...")->required();
+    sub.add_option("-o,--output", o->output, "Folder for frame_0000.png, frame_0001.png, ... (created if missing)")->required();
     sub.add_option("--size", o->size, "Frame size WxH in pixels")->capture_default_str();
     sub.add_option("--sky", o->sky, "network, or reference (the seed's sum in GLSL, on the model's tables)")
         ->capture_default_str();
@@ -158,14 +158,13 @@ void add_fly(CLI::App& sub) {
     add_json_flag(sub, o->json);
     sub.callback([o, &sub] {
         std::error_code ec;
-        if (!fs::is_directory(o->output, ec))
-            throw Error(fmt::format("the output folder {} does not exist", o->output), "--output");
         int w = 0, h = 0;
         parse_flag("--size", [&] { parse_size(o->size, w, h, "--size"); });
         if (o->sky != "network" && o->sky != "reference")
             throw UsageError("unknown sky '" + o->sky + "'; use network or reference", "--sky");
         if (o->mp4.empty())
             refuse_if_given(sub, "--fps", "without --mp4");
+        OutputFolder folder(o->output, "--output"); // created if missing, removed again on failure
         if (!o->strip.empty())
             check_output_path(o->strip, {".png"}, "--strip");
         std::string ffmpeg;
@@ -241,9 +240,11 @@ void add_fly(CLI::App& sub) {
                 throw Error(fmt::format("ffmpeg failed (exit status {})", rc), "--mp4");
         }
         files.commit();
+        folder.keep();
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        info("{} frames {}x{} from {} km to {} km in {:.1f} s ({}) -> {}/frame_0000.png ...{}", o->frames, w, h,
-             keys.front().altitude_km, keys.back().altitude_km, seconds, renderer.device_description(), o->output,
+        info("{} frames {}x{} from {} km to {} km in {:.1f} s ({}) -> {} ...{}", o->frames, w, h,
+             keys.front().altitude_km, keys.back().altitude_km, seconds, renderer.device_description(),
+             (fs::path(o->output) / "frame_0000.png").string(),
              o->mp4.empty() ? "" : ", " + o->mp4);
         if (o->json)
             print_json({{"frames", o->frames},

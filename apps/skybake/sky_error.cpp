@@ -1,6 +1,7 @@
 // skybake sky error: accuracy of a trained neural sky against its sky model.
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 
 #include "cli.h"
 #include "commands.h"
@@ -33,25 +34,23 @@ void add_sky_error(CLI::App& group) {
         ->check(integer_in(0, INT64_MAX));
     sub->add_flag("--no-views", o->no_views, "Skip the PSNR of the seed's views");
     sub->add_option("--size", o->size, "Size of the rendered views WxH")->capture_default_str();
-    sub->add_option("--views-dir", o->views_dir, "Also write the reference and neural views there as PNG (an "
-                                                 "existing folder)");
+    sub->add_option("--views-dir", o->views_dir, "Also write the reference and neural views there as PNG (a "
+                                                 "folder, created if missing)");
     add_json_flag(*sub, o->json);
     sub->callback([o, sub] {
         if (o->no_views)
             for (const char* f : {"--size", "--views-dir"})
                 refuse_if_given(*sub, f, "with --no-views");
         parse_flag("--size", [&] { parse_size(o->size, o->e.view_width, o->e.view_height, "--size"); });
-        if (!o->views_dir.empty()) { // an existing folder, or a new one in an existing folder
-            std::error_code ec;
-            if (std::filesystem::is_directory(o->views_dir, ec))
-                check_output_path((std::filesystem::path(o->views_dir) / "view.png").string(), {".png"}, "--views-dir");
-            else
-                check_output_path(o->views_dir, {}, "--views-dir");
-        }
+        std::optional<OutputFolder> views_folder; // an existing folder, or a new one in an existing folder
+        if (!o->views_dir.empty())
+            views_folder.emplace(o->views_dir, "--views-dir");
         o->e.views = !o->no_views;
         o->e.views_dir = o->views_dir;
         const NeuralSky net = load_neural_sky(o->model);
         const NeuralErrorReport r = measure_neural_sky_error(net, o->e);
+        if (views_folder)
+            views_folder->keep();
         if (o->json) {
             nlohmann::json views = nlohmann::json::array();
             for (const ViewPsnr& v : r.views)
