@@ -33,6 +33,7 @@ struct TextureBakeOptions {
     int texture_size = 2048; // width and height in texels, kMinTextureSize to kMaxTextureSize
     int uv_set = 0;          // Mesh::texcoords index (glTF TEXCOORD_n)
     int dilate_texels = 8;   // gutter grown around every UV island, texels, 0 to 256
+    bool stitch_seams = true; // make both sides of every UV seam read alike (stitch_texture_seams)
 };
 
 // The texels a UV layout covers, each with its point on the surface.
@@ -63,6 +64,27 @@ struct TexelSamples {
 // outside [0, 1] or not finite ("uv_set"), or an invalid mesh ("mesh").
 TexelSamples texel_samples(const Mesh& mesh, const TextureBakeOptions& options);
 
+// What stitch_texture_seams() did. A look-up pair is one point of a seam
+// edge read on both of its sides; mismatch is |a − b| of such a pair.
+struct SeamStitchReport {
+    std::size_t seam_edges = 0;    // edge pairs with the same 3D end points and other UVs
+    std::size_t lookups = 0;       // look-up pairs along them
+    std::size_t texels_changed = 0; // texels under some look-up (the unknowns solved for)
+    double mismatch_before_mean = 0.0, mismatch_before_max = 0.0;
+    double mismatch_after_mean = 0.0, mismatch_after_max = 0.0;
+};
+
+// Makes a texture agree with itself across the seams of a UV layout (Liu,
+// Ferguson & Jacobson 2017, "seam erasure"). A seam edge is an edge whose two
+// triangles have the same end points in space (bit for bit) but other UVs:
+// along it, sample_texture() at the UVs of one side should equal the other
+// side's. The texels under those look-ups move as little as possible, in the
+// least-squares sense, for them to agree; no other texel changes, and a
+// constant texture stays as it is. values: size × size, row-major, in [0, 1]
+// (results are clamped to it). Throws for a size that does not match values
+// ("values") or a missing UV set ("uv_set").
+SeamStitchReport stitch_texture_seams(const Mesh& mesh, int uv_set, std::vector<float>& values, int size);
+
 // [SECTION] The bake --------------------------------------------------------------------
 
 struct AoTexture {
@@ -74,10 +96,13 @@ struct AoTexture {
     std::uint64_t rays = 0;
     double build_seconds = 0.0, trace_seconds = 0.0; // as BakeOutputs
     double sample_seconds = 0.0;                     // texel_samples()
+    SeamStitchReport seams;                          // stitch_texture_seams(), when asked for
 };
 
 // AO (seed 002's V0, as bake_ambient_occlusion() computes per vertex) at every
-// covered texel, then dilate_texture(). mesh is the whole scene, in world
+// covered texel, then dilate_texture(), then (texture.stitch_seams)
+// stitch_texture_seams(): a point on a seam reads the same AO from either
+// side. mesh is the whole scene, in world
 // space, with normals; its UV set options.uv_set gives the layout. Throws as
 // texel_samples() and bake_visibility() do.
 AoTexture bake_ao_texture(const Mesh& mesh, const SphereRule& rule, VisibilityTracer& tracer,

@@ -209,6 +209,8 @@ AoTexture bake_ao_texture(const Mesh& mesh, const SphereRule& rule, VisibilityTr
         out.coverage[samples.texels[j]] = 1;
     }
     dilate_texture(out.ao, out.coverage, out.texture_size, texture.dilate_texels);
+    if (texture.stitch_seams)
+        out.seams = stitch_texture_seams(mesh, texture.uv_set, out.ao, out.texture_size);
     return out;
 }
 
