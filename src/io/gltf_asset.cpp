@@ -240,10 +240,23 @@ void GltfAsset::save(const std::filesystem::path& path) const {
         throw Error("the document has no buffer to append to", where);
     std::vector<unsigned char> bin = s.buffers[0];
     bin.resize(doc["buffers"][0].value("byteLength", std::size_t(0)), 0); // a GLB chunk may carry padding
-    if (!doc.contains("bufferViews"))
-        doc["bufferViews"] = Json::array();
-    if (!doc.contains("accessors"))
-        doc["accessors"] = Json::array();
+    // Every top-level member this function adds is added here, before any
+    // reference into the document is taken: an ordered_json object keeps its
+    // members in a vector, so a member added later would move the others and
+    // leave those references dangling.
+    const auto ensure_array = [&doc](const char* key) {
+        if (!doc.contains(key) || !doc[key].is_array())
+            doc[key] = Json::array();
+    };
+    ensure_array("bufferViews");
+    ensure_array("accessors");
+    if (!s.occlusion_image.empty()) {
+        ensure_array("images");
+        ensure_array("textures");
+        ensure_array("materials");
+    }
+    if (!doc.contains("asset") || !doc["asset"].is_object())
+        doc["asset"] = Json::object();
     Json& views = doc["bufferViews"];
     Json& accessors = doc["accessors"];
     Json& meshes = doc["meshes"];
@@ -299,15 +312,18 @@ void GltfAsset::save(const std::filesystem::path& path) const {
             append(&colors, "COLOR_0");
     }
 
+    // The input's images, as seen from the output's folder (before the AO
+    // image, whose URI is already written from there).
+    const std::filesystem::path out_dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
+    if (doc.contains("images") && doc["images"].is_array())
+        for (Json& image : doc["images"])
+            if (image.contains("uri") && image["uri"].is_string())
+                image["uri"] = relocate_uri(image["uri"].get<std::string>(), s.source_dir, out_dir);
+
     if (!s.occlusion_image.empty()) {
-        // One image and texture, referenced from every baked primitive's material.
-        if (!doc.contains("images"))
-            doc["images"] = Json::array();
-        if (!doc.contains("textures"))
-            doc["textures"] = Json::array();
-        if (!doc.contains("materials"))
-            doc["materials"] = Json::array();
-        const std::filesystem::path out_dir = path.has_parent_path() ? path.parent_path() : ".";
+        // One image and texture, referenced from every baked primitive's
+        // material. A document baked before names the image already: the same
+        // entries are used again, so that baking twice adds nothing.
         std::error_code ec;
         std::string uri;
         for (char c : std::filesystem::absolute(s.occlusion_image, ec)
@@ -315,9 +331,21 @@ void GltfAsset::save(const std::filesystem::path& path) const {
                           .lexically_relative(std::filesystem::absolute(out_dir, ec).lexically_normal())
                           .generic_string())
             uri += c == ' ' ? std::string("%20") : std::string(1, c);
-        doc["images"].push_back({{"uri", uri}});
-        doc["textures"].push_back({{"source", doc["images"].size() - 1}});
-        const Json occlusion = {{"index", doc["textures"].size() - 1}, {"texCoord", s.occlusion_uv_set}};
+        Json& images = doc["images"];
+        Json& textures = doc["textures"];
+        std::size_t image = images.size(), texture = textures.size();
+        for (std::size_t i = 0; i < images.size() && image == images.size(); ++i)
+            if (images[i].is_object() && images[i].value("uri", std::string()) == uri)
+                image = i;
+        if (image == images.size())
+            images.push_back({{"uri", uri}});
+        for (std::size_t t = 0; t < textures.size() && texture == textures.size(); ++t)
+            if (textures[t].is_object() && textures[t].contains("source") && textures[t]["source"] == image &&
+                !textures[t].contains("extensions"))
+                texture = t;
+        if (texture == textures.size())
+            textures.push_back({{"source", image}});
+        const Json occlusion = {{"index", texture}, {"texCoord", s.occlusion_uv_set}};
         std::set<std::size_t> wired;
         int bare = -1; // the material for primitives without one
         for (const auto& [node, m] : target_mesh)
@@ -342,11 +370,6 @@ void GltfAsset::save(const std::filesystem::path& path) const {
     if (generator.find("skybake") == std::string::npos)
         asset["generator"] = generator.empty() ? std::string("skybake") : generator + ", skybake";
 
-    const std::filesystem::path out_dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
-    if (doc.contains("images") && doc["images"].is_array())
-        for (Json& image : doc["images"])
-            if (image.contains("uri") && image["uri"].is_string())
-                image["uri"] = relocate_uri(image["uri"].get<std::string>(), s.source_dir, out_dir);
     Json& buffers = doc["buffers"];
     for (std::size_t i = 1; i < buffers.size(); ++i)
         if (buffers[i].contains("uri") && buffers[i]["uri"].is_string())

@@ -198,6 +198,36 @@ void validate(const json& root, const std::string& where) {
     v.each(root, "samplers", [&](const json& o, const std::string& p) {
         v.object(o, p, {{"magFilter", T::Uint}, {"minFilter", T::Uint}, {"wrapS", T::Uint}, {"wrapT", T::Uint}});
     });
+
+    // The references a bake follows and writes through: a primitive's
+    // material, a material's textures, a texture's image. One that points past
+    // its array is an invalid file (the Khronos validator's
+    // UNRESOLVED_REFERENCE), refused here rather than written out again.
+    const auto count = [&](const char* arr) {
+        auto it = root.find(arr);
+        return it == root.end() ? std::size_t(0) : it->size();
+    };
+    const auto resolves = [&](const json& o, const char* member, std::size_t n, const std::string& p) {
+        if (auto it = o.find(member); it != o.end() && it->get<std::uint64_t>() >= n)
+            throw Error(fmt::format("malformed glTF: '{}.{}' is {}, but the file has {} of them", p, member,
+                                    it->get<std::uint64_t>(), n),
+                        where);
+    };
+    v.each(root, "meshes", [&](const json& o, const std::string& p) {
+        if (auto it = o.find("primitives"); it != o.end())
+            for (std::size_t i = 0; i < it->size(); ++i)
+                resolves((*it)[i], "material", count("materials"), fmt::format("{}.primitives[{}]", p, i));
+    });
+    v.each(root, "materials", [&](const json& o, const std::string& p) {
+        for (const char* t : {"normalTexture", "occlusionTexture", "emissiveTexture"})
+            if (auto it = o.find(t); it != o.end())
+                resolves(*it, "index", count("textures"), p + "." + t);
+        if (auto pbr = o.find("pbrMetallicRoughness"); pbr != o.end())
+            for (const char* t : {"baseColorTexture", "metallicRoughnessTexture"})
+                if (auto it = pbr->find(t); it != pbr->end())
+                    resolves(*it, "index", count("textures"), p + ".pbrMetallicRoughness." + t);
+    });
+    v.each(root, "textures", [&](const json& o, const std::string& p) { resolves(o, "source", count("images"), p); });
 }
 
 std::uint32_t read_u32(const unsigned char* p) {

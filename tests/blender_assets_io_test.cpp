@@ -1,0 +1,165 @@
+// Files as Blender writes them, made in the test with `blender -b`, through the
+// commands a technical artist runs first: the texture bake into the user's
+// glTF. Label io, so that the sanitizer build (make test-sanitize) runs the
+// CLI under AddressSanitizer on them.
+//
+// Blender's exports are the common case the sample models miss: untextured
+// materials (no "images", "textures" or "samplers" arrays), or no material at
+// all (no "materials" array), with Smart UV Project's islands.
+#include <cctype>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli_runner.h"
+#include "skybake/files.h"
+#include "skybake/image.h"
+
+using skybake::test::run_cli;
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+namespace {
+
+// Suzanne with Smart UV Project, exported as the argument after "--" names it
+// (.glb or .gltf); "material" gives her a plain Principled BSDF (a material
+// without textures), "bare" none.
+constexpr const char* kBlenderScript = R"(
+import sys, bpy
+out, kind = sys.argv[sys.argv.index("--") + 1:][:2]
+bpy.ops.wm.read_factory_settings(use_empty=True)
+bpy.ops.mesh.primitive_monkey_add()
+obj = bpy.context.active_object
+bpy.ops.object.shade_smooth()
+bpy.ops.object.mode_set(mode="EDIT")
+bpy.ops.mesh.select_all(action="SELECT")
+bpy.ops.uv.smart_project()
+bpy.ops.object.mode_set(mode="OBJECT")
+if kind == "material":
+    mat = bpy.data.materials.new("Clay")
+    mat.use_nodes = True
+    mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (0.8, 0.3, 0.2, 1.0)
+    obj.data.materials.append(mat)
+fmt = "GLB" if out.endswith(".glb") else "GLTF_SEPARATE"
+bpy.ops.export_scene.gltf(filepath=out, export_format=fmt)
+)";
+
+std::string blender() {
+    for (const char* dir : {"/usr/bin", "/usr/local/bin"}) {
+        const fs::path p = fs::path(dir) / "blender";
+        if (fs::exists(p))
+            return p.string();
+    }
+    return {};
+}
+
+// Runs Blender to write `out`; false (with the reason in `why`) when it fails.
+bool make_suzanne(const fs::path& out, const std::string& kind, std::string& why) {
+    const fs::path script = out.parent_path() / "make_suzanne.py";
+    std::ofstream(script) << kBlenderScript;
+    const std::string cmd = "'" + blender() + "' -b --factory-startup --python '" + script.string() + "' -- '" +
+                            out.string() + "' " + kind + " > '" + out.string() + ".log' 2>&1";
+    if (std::system(cmd.c_str()) != 0 || !fs::exists(out)) {
+        why = skybake::read_file(out.string() + ".log");
+        return false;
+    }
+    return true;
+}
+
+Json document(const fs::path& path) {
+    const std::string data = skybake::read_file(path);
+    if (path.extension() == ".gltf")
+        return Json::parse(data);
+    std::uint32_t len = 0;
+    std::memcpy(&len, data.data() + 12, 4);
+    return Json::parse(data.substr(20, len));
+}
+
+struct Case {
+    const char* kind;   // "bare" or "material"
+    const char* input;  // file name Blender writes
+    const char* output; // file name skybake writes
+};
+
+class BlenderAssets : public ::testing::TestWithParam<Case> {};
+
+} // namespace
+
+// Every run of the same bake succeeds and writes the same bytes; the output
+// has one AO image and texture, and every triangle primitive's material reads
+// it as its occlusionTexture through the UV set the bake used.
+TEST_P(BlenderAssets, TextureBakeWiresOneOcclusionTextureEveryRun) {
+    if (blender().empty())
+        GTEST_SKIP() << "no blender (scripts/install-deps.sh installs it)";
+    const Case c = GetParam();
+    const fs::path dir = skybake::test::temp_dir(std::string("blender-assets-") + c.kind + "-" + c.output);
+    const fs::path in = dir / c.input;
+    std::string why;
+    ASSERT_TRUE(make_suzanne(in, c.kind, why)) << why;
+    {
+        const Json src = document(in);
+        ASSERT_FALSE(src.contains("images")) << "the export is not the case this test is for";
+        ASSERT_FALSE(src.contains("textures"));
+        ASSERT_EQ(src.contains("materials"), std::string(c.kind) == "material");
+    }
+    std::string first;
+    for (const int size : {64, 100, 64}) {
+        const fs::path out = dir / c.output;
+        const auto r = run_cli({"ao", in.string(), "-o", out.string(), "--texture", std::to_string(size), "--rule",
+                                "lebedev:86"},
+                               300);
+        ASSERT_EQ(r.exit_code, 0) << "size " << size << ": " << r.err;
+        const Json doc = document(out);
+        ASSERT_TRUE(doc.contains("images")) << doc.dump();
+        ASSERT_EQ(doc["images"].size(), 1u) << doc["images"].dump();
+        ASSERT_EQ(doc["textures"].size(), 1u) << doc["textures"].dump();
+        EXPECT_EQ(doc["textures"][0]["source"], 0);
+        const fs::path image = dir / doc["images"][0]["uri"].get<std::string>();
+        ASSERT_TRUE(fs::exists(image)) << image;
+        const skybake::Image ao = skybake::load_image(image);
+        EXPECT_EQ(ao.width, size);
+        EXPECT_EQ(ao.height, size);
+        ASSERT_FALSE(doc["materials"].empty()) << doc.dump();
+        int primitives = 0;
+        for (const Json& mesh : doc["meshes"])
+            for (const Json& prim : mesh["primitives"]) {
+                ++primitives;
+                ASSERT_TRUE(prim.contains("material")) << prim.dump();
+                const Json& mat = doc["materials"][prim["material"].get<std::size_t>()];
+                ASSERT_TRUE(mat.contains("occlusionTexture")) << mat.dump();
+                EXPECT_EQ(mat["occlusionTexture"]["index"], 0);
+                EXPECT_EQ(mat["occlusionTexture"]["texCoord"], 0);
+                EXPECT_TRUE(prim["attributes"].contains("TEXCOORD_0"));
+            }
+        EXPECT_GE(primitives, 1);
+        if (std::string(c.kind) == "material")
+            EXPECT_EQ(doc["materials"][0]["name"], "Clay") << "the user's material was replaced";
+        const std::string bytes = skybake::read_file(out);
+        if (size == 64) {
+            if (first.empty())
+                first = bytes;
+            else
+                EXPECT_EQ(bytes, first) << "two runs of the same bake wrote different files";
+        }
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(, BlenderAssets,
+                         ::testing::Values(Case{"bare", "plain.glb", "out.glb"}, Case{"bare", "plain.glb", "out.gltf"},
+                                           Case{"material", "clay.glb", "out.glb"},
+                                           Case{"material", "clay.gltf", "out.gltf"}),
+                         [](const auto& info) {
+                             std::string name = std::string(info.param.kind) + "_" + info.param.input + "_to_" +
+                                                info.param.output;
+                             for (char& ch : name)
+                                 if (!std::isalnum(static_cast<unsigned char>(ch)))
+                                     ch = '_';
+                             return name;
+                         });
