@@ -165,6 +165,40 @@ TEST(AoCli, BadInputIsOneLineAndNoOutput) {
     }
 }
 
+// Finite values beyond the tracers' range (skybake/bake.h kMaxTraceCoordinate,
+// kMaxRayOffset): Embree aborts on rays that start beyond ±1.8e18, so they are
+// refused first, a flag with exit 2 and a file with exit 1. The largest values
+// taken still bake.
+TEST(AoCli, ValuesBeyondTheTracersRangeAreRefused) {
+    const std::string dir = skybake::test::temp_dir("ao-cli-range");
+    const std::string in = wall_mesh(dir), out = dir + "/out.glb";
+    for (const char* offset : {"2e18", "1e20", "1.1e17"})
+        expect_one_line_error(run_cli({"ao", in, "-o", out, "--offset", offset}), 2, "--offset");
+    EXPECT_EQ(run_cli({"ao", in, "-o", out, "--offset", "1e17", "--rule", "lebedev:6"}).exit_code, 0);
+    fs::remove(out);
+    // A tetrahedron around 1e19 (finite floats, beyond the range), and one at 1e17 (inside).
+    const auto tetra = [&](const std::string& name, const char* scale) {
+        const std::string path = dir + "/" + name;
+        std::ofstream(path) << "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+                               "property float z\nelement face 4\nproperty list uchar int vertex_indices\n"
+                               "end_header\n0 0 0\n" << scale << " 0 0\n0 " << scale << " 0\n0 0 " << scale
+                            << "\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+        return path;
+    };
+    const std::string huge = tetra("huge.ply", "1e19"), large = tetra("large.ply", "5e16");
+    expect_one_line_error(run_cli({"ao", huge, "-o", out}), 1, "coordinate reaches");
+    expect_one_line_error(run_cli({"prt", "bake", huge, "-o", dir + "/out_prt.glb", "--rule", "lebedev:6"}), 1,
+                          "coordinate reaches");
+    EXPECT_FALSE(fs::exists(dir + "/out_prt.glb"));
+    const auto r = run_cli({"ao", large, "-o", out, "--rule", "lebedev:26", "--json"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const skybake::Mesh baked = skybake::load_mesh(out);
+    const skybake::VertexAttribute* ao = baked.find_attribute("ao");
+    ASSERT_NE(ao, nullptr);
+    for (float v : ao->values) // a convex tetrahedron's vertices see their whole hemisphere
+        EXPECT_GT(v, 0.5f);
+}
+
 TEST(AoCli, BruteForceBackendAgreesOnASmallMesh) {
     const std::string dir = skybake::test::temp_dir("ao-cli-brute");
     const std::string in = dir + "/wall.glb";

@@ -195,7 +195,7 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
         asset = GltfAsset::load(o.input);
     else if (lower_extension(o.output) == ".gltf")
         throw UsageError("a .gltf output keeps a glTF 2.0 input's document; write other inputs as .glb", "--output");
-    Mesh plain = asset ? Mesh() : load_mesh(o.input);
+    Mesh plain = asset ? Mesh() : load_model(o.input);
     Mesh& mesh = asset ? asset->mesh() : plain;
     test_fault_point("load");
     // The texture bake first: its checks of the UV layout and the size come
@@ -524,7 +524,7 @@ void add_ao_bake(CLI::App& group) {
     sub->add_option("--offset", o->offset,
                     "Move ray origins this much further along the normal, in mesh units; auto (= 0): only the "
                     "step past rounding, 2^-15 of the vertex's coordinates")
-        ->check(auto_or_real_in(0.0, 1e30, "mesh units"))
+        ->check(auto_or_real_in(0.0, kMaxRayOffset, "mesh units"))
         ->capture_default_str();
     sub->add_option("--back-faces", o->back_faces,
                     "occlude: both sides of a triangle block rays; ignore: rays pass through triangles seen from "

@@ -69,14 +69,23 @@ namespace skybake {
 // standing on the ground, then starts its rays on its own side of the other
 // surface instead of on it.
 
+// The range every tracer takes (Embree, the CUDA BVH, the raster's depth
+// maps): mesh coordinates and the ray offset up to 1e17 mesh units each.
+// Embree treats a ray whose origin has a coordinate beyond ±1.844e18
+// (FLT_LARGE) as invalid and aborts; 1e17 + 1e17·√2 stays an order of
+// magnitude inside it, and squared distances (≤ 1e35) inside a float. The
+// bake refuses more with an Error naming "mesh" or "ray_offset".
+inline constexpr double kMaxTraceCoordinate = 1e17;
+inline constexpr double kMaxRayOffset = 1e17;
+
 struct BakeOptions {
     // Occluders further than this from the ray origin are ignored, in mesh units.
     // Infinity (the default) means unlimited; must be > 0.
     float max_distance = std::numeric_limits<float>::infinity();
     // Distance the ray origin is moved along the vertex normal (and, on borders
     // and creases, towards the vertex's triangles), in mesh units, on top of
-    // the step past rounding that every origin gets. ≥ 0; 0 by default. A
-    // negative value means 0 (the former "scene-relative default").
+    // the step past rounding that every origin gets. In [0, kMaxRayOffset];
+    // 0 by default. A negative value means 0 (the former "scene-relative default").
     float ray_offset = 0.0f;
     BackFaces back_faces = BackFaces::Occlude;
     // false (the seed's definition): the sums above, clamped to [0, 1] (rules

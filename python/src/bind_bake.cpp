@@ -36,8 +36,8 @@ BakeOptions bake_options(float max_distance, float offset, const std::string& ba
     BakeOptions b;
     if (!(max_distance > 0.0f))
         throw Error("must be > 0 (inf: unlimited)", "max_distance");
-    if (!(offset >= 0.0f) || !std::isfinite(offset))
-        throw Error("must be a finite value ≥ 0", "offset");
+    if (!(offset >= 0.0f && offset <= kMaxRayOffset)) // NaN and inf fail too
+        throw Error("must be in [0, 1e17] mesh units (the tracers' range)", "offset"); // kMaxRayOffset
     b.max_distance = max_distance;
     b.ray_offset = offset;
     b.back_faces = parse_back_faces(back_faces);

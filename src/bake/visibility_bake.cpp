@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <span>
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
@@ -37,6 +38,19 @@ constexpr std::uint32_t kMinChunk = 4096;
 constexpr std::uint64_t kChunkRays = std::uint64_t(1) << 23;
 constexpr std::uint32_t kSmallestChunk = 256;
 
+// Coordinates beyond the tracers' range (kMaxTraceCoordinate): finite, but
+// Embree aborts on rays that start there.
+void check_trace_range(std::span<const glm::vec3> positions, const char* field) {
+    float largest = 0.0f;
+    for (const glm::vec3& p : positions)
+        largest = std::max({largest, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    if (largest > kMaxTraceCoordinate)
+        throw Error(fmt::format("a coordinate reaches {:g} mesh units; the tracers take up to {:g} (scale the "
+                                "model down)",
+                                largest, kMaxTraceCoordinate),
+                    field);
+}
+
 void check_inputs(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options) {
     validate_mesh(mesh, "mesh");
     const std::size_t n = mesh.vertex_count();
@@ -55,9 +69,11 @@ void check_inputs(const Mesh& mesh, const SphereRule& rule, const BakeOptions& o
         throw Error(fmt::format("maximum distance must be > 0 mesh units (infinity for unlimited); got {}",
                                 options.max_distance),
                     "max_distance");
-    if (!std::isfinite(options.ray_offset))
-        throw Error(fmt::format("ray offset must be a finite distance in mesh units; got {}", options.ray_offset),
+    if (!std::isfinite(options.ray_offset) || options.ray_offset > kMaxRayOffset)
+        throw Error(fmt::format("ray offset must be a distance in [0, {:g}] mesh units; got {:g}", kMaxRayOffset,
+                                options.ray_offset),
                     "ray_offset");
+    check_trace_range(mesh.positions, "mesh");
 }
 
 } // namespace
@@ -207,6 +223,7 @@ VisibilityBakeStats bake_visibility(const Mesh& mesh, const SamplePoints& points
                     "points");
     if (n >= std::size_t(0xffffffffu))
         throw Error(fmt::format("{} sample points is too many; the bake handles up to 4,294,967,294", n), "points");
+    check_trace_range(points.positions, "points");
     const float offset = resolve_ray_offset(mesh, options);
     const auto frame = [&](std::size_t v, glm::vec3& origin, glm::vec3& normal, glm::vec3& offset_direction) {
         normal = points.normals[v];

@@ -50,7 +50,7 @@ class SkybakeSettings(bpy.types.PropertyGroup):
     max_distance: bpy.props.FloatProperty(name="Max distance", default=0.0, min=0.0, soft_max=100.0,
                                           subtype="DISTANCE", unit="LENGTH",
                                           description="Ignore occluders further than this (world units); 0: unlimited")
-    offset: bpy.props.FloatProperty(name="Offset", default=0.0, min=0.0, soft_max=0.1, precision=4,
+    offset: bpy.props.FloatProperty(name="Offset", default=0.0, min=0.0, max=1e17, soft_max=0.1, precision=4,
                                     subtype="DISTANCE", unit="LENGTH",
                                     description="Move ray origins this much along the normal (world units)")
     back_faces: bpy.props.EnumProperty(name="Back faces", items=BACK_FACES, default="occlude")
