@@ -207,6 +207,37 @@ TEST_F(ViewWindow, PlanetWindowDrawsTenFramesAndCloses) {
     EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
+// SIGINT and SIGTERM end either window with 128 + N, as every command does
+// (main.cpp). The signal is sent once the window draws: after the time a run
+// of three frames takes, plus half a second. The bound on the time from the
+// signal to the exit is loose (the window checks once a frame); a window that
+// ignored the signal would run until the runner's alarm.
+TEST_F(ViewWindow, SignalsEndTheWindowWith128PlusN) {
+    const std::string obj = dir_ + "/tetra.obj";
+    std::ofstream(obj) << kTetra;
+    const std::vector<std::vector<std::string>> commands = {
+        {"view", "planet", "--model", kNetwork, "--size", "160x120"}, {"view", obj, "--size", "160x120"}};
+    for (const auto& command : commands) {
+        std::vector<std::string> three = command;
+        three.insert(three.end(), {"--frames", "3"});
+        const auto t0 = std::chrono::steady_clock::now();
+        const auto warm = run_cli(three, 120);
+        const double start_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        ASSERT_EQ(warm.exit_code, 0) << command[1] << ": " << warm.err;
+        for (const int sig : {SIGINT, SIGTERM}) {
+            const double after_s = start_s + 0.5;
+            const auto t1 = std::chrono::steady_clock::now();
+            const auto r = test::run_cli_interrupted(command, after_s, sig, false, 60);
+            const double total_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+            EXPECT_EQ(r.exit_code, 128 + sig) << command[1] << " signal " << sig << ": " << r.err;
+            EXPECT_EQ(r.err_lines(), 1) << r.err;
+            EXPECT_NE(r.err.find("interrupted by"), std::string::npos) << r.err;
+            EXPECT_LT(total_s - after_s, 10.0) << command[1] << " signal " << sig;
+            std::printf("%s, signal %d: ended %.2f s after it\n", command[1].c_str(), sig, total_s - after_s);
+        }
+    }
+}
+
 TEST(ViewWindowNoDisplay, OneLineExitOne) {
     if (!viewer_window_available())
         GTEST_SKIP() << "this build has no window";

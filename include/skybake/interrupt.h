@@ -28,4 +28,11 @@ int interrupt_signal();
 // Throws Interrupted if a signal was recorded. Cheap: call it in loops.
 void check_interrupted();
 
+// For hosts that own the signal handlers (the Python module): records
+// `signal` as a handler of theirs received it, so that every loop that calls
+// check_interrupted() stops; safe to call from a signal handler (one atomic
+// store). clear_interrupt() forgets it, before the host's next long call.
+void request_interrupt(int signal) noexcept;
+void clear_interrupt() noexcept;
+
 } // namespace skybake

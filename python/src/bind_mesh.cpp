@@ -120,9 +120,10 @@ void bind_mesh(py::module_& m) {
                 if (!py::isinstance<py::array>(values))
                     throw Error("expected a NumPy array of float32", "values");
                 const auto ndim = py::reinterpret_borrow<py::array>(values).ndim();
-                const auto arr = ndim == 1 ? checked_array<float>(values, "values", {py::ssize_t(mesh.vertex_count())})
+                const auto arr = ndim == 1 ? checked_array<float>(values, "values", {py::ssize_t(mesh.vertex_count())},
+                                                                  /*finite=*/true)
                                            : checked_array<float>(values, "values",
-                                                                  {py::ssize_t(mesh.vertex_count()), -1});
+                                                                  {py::ssize_t(mesh.vertex_count()), -1}, true);
                 const int components = ndim == 1 ? 1 : int(arr.shape(1));
                 if (components < 1 || components > 4)
                     throw Error("an attribute has 1 to 4 components, got " + std::to_string(components), "values");
@@ -149,18 +150,15 @@ void bind_mesh(py::module_& m) {
 
     m.def(
         "load_mesh",
-        [](const std::filesystem::path& path) {
-            py::gil_scoped_release release;
-            return load_mesh(path);
-        },
+        [](const std::filesystem::path& path) { return long_call(py::none(), [&] { return load_mesh(path); }); },
         py::arg("path"),
         "Reads any mesh skybake reads (glTF, PLY, and OBJ, STL, OFF, FBX, ... through Assimp). Normals are "
         "computed when the file has none. Raises skybake.Error for a missing, malformed or empty file.");
     m.def(
         "save_mesh",
         [](const std::filesystem::path& path, const Mesh& mesh, bool ascii) {
-            py::gil_scoped_release release;
-            save_mesh(path, mesh, ExportOptions{ascii ? PlyEncoding::Ascii : PlyEncoding::Binary});
+            long_call(py::none(),
+                      [&] { save_mesh(path, mesh, ExportOptions{ascii ? PlyEncoding::Ascii : PlyEncoding::Binary}); });
         },
         py::arg("path"), py::arg("mesh"), py::arg("ascii") = false,
         "Writes .glb (attributes as \"_NAME\") or .ply (ascii: text PLY). Atomic.");

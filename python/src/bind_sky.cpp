@@ -147,10 +147,14 @@ void bind_sky(py::module_& m) {
         .def_static(
             "reference",
             [](const Atmosphere& atmosphere, const std::string& method, const std::string& device) {
-                return SkySource::reference(SkyModel(atmosphere), parse_method(method), parse_device(device));
+                const SkyMethod sky_method = parse_method(method);
+                const Device d = parse_device(device);
+                // The tables (seconds with multiple scattering): Ctrl-C stops them.
+                return long_call(py::none(), [&] { return SkySource::reference(SkyModel(atmosphere), sky_method, d); });
             },
             py::arg("atmosphere"), py::arg("method") = "tables", py::arg("device") = "cpu",
-            "The reference model: 'tables' (the seed's sum) or 'exact' (quadrature; CPU only).")
+            "The reference model: 'tables' (the seed's sum) or 'exact' (quadrature; CPU only). The GIL is "
+            "released while the tables are built; Ctrl-C stops them.")
         .def_static(
             "network",
             [](const NeuralSky& net, const std::string& device) {

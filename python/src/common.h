@@ -137,8 +137,10 @@ Image numpy_to_image(const py::handle& rgb, const char* name);
 
 // While alive: the GIL is released, progress events go to `progress` (a
 // callable taking a skybake.ProgressEvent, or None) and SIGINT is caught
-// (on the main thread). finish() must be called once the work has returned
-// or thrown; it re-raises what the callback raised, or KeyboardInterrupt.
+// (on the main thread) for every call, however many came before. run()
+// re-raises what the callback raised, or KeyboardInterrupt; a Ctrl-C that
+// came after the work's last step is handed to Python when the call ends, so
+// KeyboardInterrupt follows the returned result.
 class LongCall {
 public:
     explicit LongCall(py::object progress);
@@ -152,15 +154,7 @@ public:
     auto run(F&& f) -> decltype(f()) {
         try {
             py::gil_scoped_release release;
-            if constexpr (std::is_void_v<decltype(f())>) {
-                f();
-                after_success();
-                return;
-            } else {
-                auto result = f();
-                after_success();
-                return result;
-            }
+            return f();
         } catch (const Stopped&) {
             raise_stored();
         } catch (const Error&) {
@@ -175,7 +169,6 @@ private:
     struct Stopped : Error { // thrown through the library by the callback
         Stopped() : Error("stopped by the progress callback") {}
     };
-    void after_success();
     bool interrupted() const;
     [[noreturn]] void raise_stored();
     [[noreturn]] void raise_keyboard_interrupt();

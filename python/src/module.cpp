@@ -32,12 +32,15 @@ py::array_t<float> to_numpy(std::vector<glm::vec3>&& values) {
 
 namespace {
 
-std::atomic<bool> g_sigint{false};
+// SIGINT during a long call is recorded in the library's flag (skybake/interrupt.h),
+// which every long loop polls: progress steps, the raster tracer's passes, the
+// importer's wait, file writes.
 extern "C" void on_sigint(int) {
-    g_sigint.store(true);
+    request_interrupt(SIGINT);
 }
 
 unsigned long g_main_thread = 0; // threading.main_thread().ident
+int g_depth = 0;                 // long calls running on the main thread (one unless a callback nests one)
 
 bool on_main_thread() {
     return PyThread_get_thread_ident() == g_main_thread;
@@ -55,19 +58,25 @@ LongCall::LongCall(py::object progress) : progress_(std::move(progress)) {
     // Ctrl-C: Python's own handler only runs on the main thread between
     // bytecodes, which never come while the GIL is released. Catch SIGINT
     // here for the length of the call and stop at the next progress step.
-    if (on_main_thread()) {
+    if (on_main_thread() && g_depth == 0) {
+        // A Ctrl-C that came just before (Python's handler recorded it): raise
+        // it now rather than after the work.
+        if (PyErr_CheckSignals() != 0)
+            throw py::error_already_set();
         saved_ = new SavedHandler;
         struct sigaction sa;
         std::memset(&sa, 0, sizeof sa);
         sa.sa_handler = on_sigint;
         sigemptyset(&sa.sa_mask);
-        g_sigint.store(false);
+        clear_interrupt(); // what an earlier call saw is not this call's
         handler_installed_ = sigaction(SIGINT, &sa, &saved_->old) == 0;
     }
+    if (on_main_thread())
+        ++g_depth;
     PyObject* callable = progress_.is_none() ? nullptr : progress_.ptr();
     previous_ = set_progress_callback([this, callable](const ProgressEvent& e) {
-        if (g_sigint.load())
-            throw Interrupted(SIGINT);
+        if (handler_installed_)
+            check_interrupted();
         if (!callable)
             return;
         py::gil_scoped_acquire gil;
@@ -88,22 +97,22 @@ LongCall::LongCall(py::object progress) : progress_(std::move(progress)) {
 
 LongCall::~LongCall() {
     set_progress_callback(std::move(previous_));
-    if (handler_installed_)
+    if (on_main_thread())
+        --g_depth;
+    if (handler_installed_) {
         sigaction(SIGINT, &saved_->old, nullptr);
+        // A Ctrl-C that no KeyboardInterrupt has answered yet (it came after the
+        // last step, or while the result was handed back): Python raises it at
+        // its next bytecode. Checked after the handler is back, so none is lost.
+        if (interrupt_signal() != 0)
+            PyErr_SetInterrupt();
+        clear_interrupt();
+    }
     delete saved_;
 }
 
 bool LongCall::interrupted() const {
-    return g_sigint.load();
-}
-
-void LongCall::after_success() {
-    // A Ctrl-C during the last step, after the last progress event: the
-    // result is complete, so it is returned and the signal handed to Python.
-    if (handler_installed_ && g_sigint.load()) {
-        py::gil_scoped_acquire gil;
-        PyErr_SetInterrupt();
-    }
+    return handler_installed_ && interrupt_signal() != 0;
 }
 
 void LongCall::raise_stored() {
@@ -114,6 +123,7 @@ void LongCall::raise_stored() {
 }
 
 void LongCall::raise_keyboard_interrupt() {
+    clear_interrupt(); // answered; a later Ctrl-C is a new one
     PyErr_SetNone(PyExc_KeyboardInterrupt);
     throw py::error_already_set();
 }
@@ -145,7 +155,7 @@ std::vector<BackendInfo> backends() {
 }
 
 Image image_from_array(const py::handle& obj, const char* name) {
-    const auto arr = checked_array<float>(obj, name, {-1, -1, 3});
+    const auto arr = checked_array<float>(obj, name, {-1, -1, 3}, /*finite=*/true);
     Image img(int(arr.shape(1)), int(arr.shape(0)));
     std::memcpy(img.rgb.data(), arr.data(), img.rgb.size() * sizeof(float));
     return img;
@@ -186,7 +196,13 @@ void bind_core(py::module_& m) {
     m.def("build_has_cuda", &build_has_cuda, "Whether this build has the CUDA backends (a GPU may still be absent).");
     m.def("cuda_device_count", &cuda_device_count, "CUDA devices usable now (0 without CUDA or a GPU).");
     m.def(
-        "set_threads", [](int n) { set_thread_count(n); }, py::arg("count"),
+        "set_threads",
+        [](int n) {
+            if (n < 0)
+                throw Error("must be ≥ 0 (0: all hardware threads), got " + std::to_string(n), "count");
+            set_thread_count(n);
+        },
+        py::arg("count"),
         "Limits the worker threads (0: all hardware threads). Results do not depend on it.");
     m.def("threads", &thread_count, "The worker thread count.");
     m.def("set_quiet", &set_quiet, py::arg("quiet"), "Quiet mode: no progress bars or notes on stderr.");

@@ -2,6 +2,9 @@
 progress, the GIL and Ctrl-C."""
 import os
 import signal
+import subprocess
+import sys
+import textwrap
 import threading
 import time
 
@@ -98,6 +101,16 @@ def test_backends_and_bad_options(bowl):
     with pytest.raises(skybake.Error) as info:
         skybake.bake_ao(bowl.copy(), backend="embree", method="cube")
     assert info.value.where == "method"
+    # Beyond the tracers' range (Embree aborts past 1.8e18): refused, the interpreter lives.
+    for offset in (1e20, 2e18, 1e40, float("inf")):
+        with pytest.raises(skybake.Error) as info:
+            skybake.bake_ao(bowl.copy(), offset=offset)
+        assert info.value.where == "offset"
+    far = bowl.copy()
+    far.positions = far.positions * np.float32(1e19)
+    with pytest.raises(skybake.Error, match="coordinate reaches") as info:
+        skybake.bake_ao(far)
+    assert info.value.where == "mesh"
 
 
 def test_empty_mesh_is_an_error():
@@ -181,6 +194,92 @@ def test_ctrl_c_raises_keyboard_interrupt():
     assert time.perf_counter() - t0 < 30
     # Python's handler is back: the next call runs normally.
     skybake.bake_ao(skybake.generate_mesh("sphere", 200))
+
+
+def run_child(code, timeout=120):
+    """Runs `code` in a fresh interpreter with this module; returns the process."""
+    return subprocess.Popen([sys.executable, "-c", textwrap.dedent(code)], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env=dict(os.environ))
+
+
+INTERRUPTED_CALLS = """
+    import sys, skybake
+    m = skybake.generate_mesh("city", 20000, seed=2)
+    sky = skybake.Sky.reference(skybake.atmosphere_preset("earth"))
+    calls = {
+        "bake_ao": lambda: skybake.bake_ao(m.copy(), rule="lebedev:5810"),
+        "render": lambda: sky.render(4096, 2048, view="panorama"),
+        "bake_transfer": lambda: skybake.bake_transfer(m.copy(), rule="lebedev:5810"),
+        "raster": lambda: skybake.bake_ao(m.copy(), rule="lebedev:5810", backend="raster", resolution=512),
+    }
+    for name in sys.argv[1:]:
+        print("go", name, flush=True)
+        try:
+            calls[name]()
+            print("finished", name, flush=True)
+        except KeyboardInterrupt:
+            print("KeyboardInterrupt", name, flush=True)
+"""
+
+
+def test_every_ctrl_c_stops_a_long_call():
+    # One Ctrl-C per call, call after call: each must raise KeyboardInterrupt
+    # within seconds (each call alone runs for minutes on two cores).
+    names = ["bake_ao", "render", "bake_ao", "bake_transfer", "render"]
+    raster = [b for b in skybake.backends() if b.name == "raster"][0]
+    if raster.available:  # its passes poll the library's flag, not the progress steps
+        names += ["raster", "bake_ao", "raster"]
+    p = subprocess.Popen([sys.executable, "-c", textwrap.dedent(INTERRUPTED_CALLS), *names],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    watchdog = threading.Timer(60 + 20 * len(names), p.kill)
+    watchdog.start()
+    try:
+        seen = []
+        for line in p.stdout:
+            word, name = line.split()
+            if word == "go":
+                time.sleep(0.5)
+                t0 = time.perf_counter()
+                os.kill(p.pid, signal.SIGINT)
+            else:
+                seen.append((word, name, time.perf_counter() - t0))
+        p.wait()
+    finally:
+        watchdog.cancel()
+    assert p.returncode == 0, p.stderr.read()
+    assert [(w, n) for w, n, _ in seen] == [("KeyboardInterrupt", n) for n in names], seen
+    assert max(s for _, _, s in seen) < 20, seen
+
+
+def test_ctrl_c_while_the_result_is_handed_back_raises():
+    # The signal comes after the bake's last step, while the call waits for the
+    # GIL to return its result (another thread holds it): KeyboardInterrupt
+    # follows the result instead of being dropped with the call's handler.
+    p = run_child("""
+        import os, signal, sys, threading, time, skybake
+        sys.setswitchinterval(1000)  # the spinning thread keeps the GIL until it ends
+        m = skybake.generate_mesh("city", 1000, seed=2)
+        def hold_the_gil():
+            time.sleep(0.01)  # wakes up during the bake, which released the GIL
+            end = time.perf_counter() + 0.5
+            while time.perf_counter() < end:  # the bake (~0.1 s) ends meanwhile
+                pass
+            os.kill(os.getpid(), signal.SIGINT)
+        t = threading.Thread(target=hold_the_gil)
+        try:
+            t.start()
+            t0 = time.perf_counter()
+            skybake.bake_ao(m, rule="lebedev:590")
+            print("returned after", time.perf_counter() - t0, flush=True)
+            time.sleep(3)
+            print("lost")
+        except KeyboardInterrupt:
+            print("KeyboardInterrupt")
+        t.join()
+    """)
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == 0, err
+    assert out.splitlines()[-1] == "KeyboardInterrupt", out
 
 
 def test_preview_shows_the_values(bowl):

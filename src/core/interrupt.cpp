@@ -41,6 +41,14 @@ int interrupt_signal() {
     return g_signal.load(std::memory_order_relaxed);
 }
 
+void request_interrupt(int signal) noexcept {
+    g_signal.store(signal, std::memory_order_relaxed);
+}
+
+void clear_interrupt() noexcept {
+    g_signal.store(0, std::memory_order_relaxed);
+}
+
 void check_interrupted() {
     if (const int s = g_signal.load(std::memory_order_relaxed))
         throw Interrupted(s);

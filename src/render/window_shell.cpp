@@ -16,6 +16,7 @@
 
 #include "render/shaders.h"
 #include "skybake/error.h"
+#include "skybake/interrupt.h"
 
 namespace skybake::render {
 
@@ -85,6 +86,7 @@ void WindowShell::make_current() {
 }
 
 bool WindowShell::begin_frame() {
+    check_interrupted(); // SIGINT or SIGTERM (recorded by the CLI's handlers) ends the window with 128 + N
     if (frame_limit_ > 0 && frames_ >= frame_limit_)
         return false;
     glfwPollEvents();

@@ -41,6 +41,8 @@ public:
 
     // Polls events and starts an ImGui frame; false when the window should
     // close (closed, Esc, or the frame limit reached): then draw nothing more.
+    // Throws skybake::Interrupted once SIGINT or SIGTERM was recorded
+    // (skybake/interrupt.h), so that a signal ends the window at the next frame.
     bool begin_frame();
     // Draws ImGui over the frame and swaps buffers. capture: also writes what
     // the window shows (the panel included) to this PNG before the swap.
