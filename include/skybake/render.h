@@ -18,6 +18,7 @@
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -116,10 +117,34 @@ struct ViewerOptions {
     int width = 1280, height = 1024;
     double altitude_km = 0.002;
     double sun_elevation_deg = 20.0, sun_azimuth_deg = 0.0;
-    double exposure_ev = 0.0; // initial exposure, stops
-    int frames = 0;           // > 0: close after this many frames (tests)
+    // The starting view (planet_viewer_view): yaw from +x towards +y, pitch
+    // above the horizontal; a NaN pitch: planet_viewer_default_pitch_deg().
+    double yaw_deg = 0.0, pitch_deg = std::numeric_limits<double>::quiet_NaN();
+    // auto_exposure: the first frame sets the exposure (model_auto_exposure_ev,
+    // as `skybake view MODEL`); else exposure_ev, stops.
+    bool auto_exposure = true;
+    double exposure_ev = 0.0;
+    int frames = 0; // > 0: close after this many frames (tests)
     std::string screenshot = "skybake_planet.png"; // where the screenshot key (P) writes
 };
+// The viewer's camera at eye_km (planet-centred, km), in the local frame of
+// the eye: yaw_deg is the heading, from the local east (+x above the pole,
+// the starting point) towards the north (+y), as the sun's azimuth (yaw =
+// sun azimuth faces the sun); pitch_deg the angle above the local horizontal,
+// −90 straight down to 90 straight up (the screen's right stays horizontal;
+// straight down, the heading is at the top of the screen). Above the pole
+// this is the camera of `sky render --view camera` with --yaw and --pitch.
+// fov_x 90°; the sun as in `sky render`, in the frame of the starting point.
+PlanetView planet_viewer_view(const glm::dvec3& eye_km, double yaw_deg, double pitch_deg, double sun_azimuth_deg,
+                              double sun_elevation_deg, int width, int height);
+// The starting pitch when none is given: 5° above the horizontal, less 1.5
+// times the dip of the horizon (acos(R / (R + altitude))), at least −90°. Near
+// the ground it is about 5° (the horizon a little below the centre); from high
+// up it looks down, the horizon in the upper part of the view and the planet
+// below (at 2000 km on Earth: −55.7°, the horizon 40.4° down); from beyond
+// about 7800 km on Earth straight down at the disc.
+double planet_viewer_default_pitch_deg(double planet_radius_km, double altitude_km);
+
 // Opens a GLFW window with a Dear ImGui panel and runs until it is closed.
 // Throws skybake::Error when no display can be opened or the build has no
 // window (one line, naming "display").

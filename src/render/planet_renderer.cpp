@@ -568,6 +568,33 @@ PlanetView planet_view_from_settings(const Atmosphere& atm, const SkyRenderSetti
     return v;
 }
 
+PlanetView planet_viewer_view(const glm::dvec3& eye_km, double yaw_deg, double pitch_deg, double sun_azimuth_deg,
+                              double sun_elevation_deg, int width, int height) {
+    // Local frame at the eye: up, and a horizontal east/north basis (+x, +y above the pole).
+    const glm::dvec3 up = glm::normalize(eye_km);
+    glm::dvec3 east = glm::cross(glm::dvec3(0, 0, 1), up);
+    east = glm::length(east) < 1e-9 ? glm::dvec3(1, 0, 0) : glm::normalize(east);
+    const glm::dvec3 north = glm::cross(up, east);
+    const double yaw = yaw_deg * kDeg, pitch = pitch_deg * kDeg;
+    const glm::dvec3 heading = std::cos(yaw) * east + std::sin(yaw) * north;
+    const glm::dvec3 right = glm::cross(heading, up); // horizontal, whatever the pitch
+    PlanetView v;
+    v.eye_km = eye_km;
+    v.forward = std::cos(pitch) * heading + std::sin(pitch) * up;
+    v.up = glm::cross(right, v.forward); // straight down too: the heading at the top of the screen
+    v.fov_x_deg = 90.0;
+    v.width = width;
+    v.height = height;
+    v.sun = glm::dvec3(sky::direction_from_angles(float(sun_azimuth_deg * kDeg), float(sun_elevation_deg * kDeg)));
+    return v;
+}
+
+double planet_viewer_default_pitch_deg(double planet_radius_km, double altitude_km) {
+    const double r = planet_radius_km + std::max(altitude_km, 0.0);
+    const double dip_deg = std::acos(std::min(1.0, planet_radius_km / r)) / kDeg;
+    return std::max(-90.0, 5.0 - 1.5 * dip_deg);
+}
+
 Image render_sky_gl(const SkyModel& tables, const NeuralSky* net, const SkyRenderSettings& s,
                     const PlanetRenderOptions& options) {
     sky::make_render_hd(tables, s); // the CPU renderer's checks of the settings

@@ -17,8 +17,8 @@
 #include <glm/geometric.hpp>
 #include <imgui.h>
 
-#include "sky/render_hd.h"
 #include "skybake/error.h"
+#include "skybake/viewer.h"
 
 namespace skybake {
 
@@ -38,26 +38,25 @@ void run_planet_viewer(const SkyModel& tables, const NeuralSky* net, const Viewe
     scenes[mode] = std::make_unique<PlanetScene>(shell, tables, net, ro[mode]);
     const double R = tables.atmosphere().planet_radius_km;
     glm::dvec3 eye(0.0, 0.0, R + o.altitude_km);
-    double yaw = 0.0, pitch = 5.0 * kDeg;
+    // Degrees; from high up the default pitch looks down at the planet.
+    double yaw = o.yaw_deg,
+           pitch = std::isnan(o.pitch_deg) ? planet_viewer_default_pitch_deg(R, o.altitude_km) : o.pitch_deg;
     float sun_el = float(o.sun_elevation_deg), sun_az = float(o.sun_azimuth_deg);
     float exposure = float(o.exposure_ev);
+    bool need_auto_exposure = o.auto_exposure; // set from the first frame, as `skybake view MODEL`
     std::unique_ptr<RenderTarget> target;
     while (shell.begin_frame()) {
         const double dt = shell.seconds_per_frame();
-        // Local frame at the eye: up, and a horizontal east/north basis.
-        const glm::dvec3 up = glm::normalize(eye);
-        glm::dvec3 east = glm::cross(glm::dvec3(0, 0, 1), up);
-        east = glm::length(east) < 1e-9 ? glm::dvec3(1, 0, 0) : glm::normalize(east);
-        const glm::dvec3 north = glm::cross(up, east);
-        const glm::dvec3 fwd = std::cos(pitch) * (std::cos(yaw) * east + std::sin(yaw) * north) + std::sin(pitch) * up;
-        const glm::dvec3 right = glm::normalize(glm::cross(fwd, up));
         // Mouse look.
         double dx, dy;
         shell.drag(dx, dy);
-        yaw -= dx * 0.004;
-        pitch = std::clamp(pitch - dy * 0.004, -1.55, 1.55);
-        // Flight, speed proportional to the altitude.
+        yaw -= dx * 0.004 / kDeg;
+        pitch = std::clamp(pitch - dy * 0.004 / kDeg, -90.0, 90.0);
         const double alt = glm::length(eye) - R;
+        const PlanetView cam = planet_viewer_view(eye, yaw, pitch, sun_az, sun_el, 1, 1);
+        const glm::dvec3 up = glm::normalize(eye), fwd = cam.forward;
+        const glm::dvec3 right = glm::normalize(glm::cross(fwd, cam.up));
+        // Flight, speed proportional to the altitude.
         const double speed = std::max(alt, 0.002) * (shell.key_down(GLFW_KEY_LEFT_SHIFT) ? 10.0 : 1.0);
         glm::dvec3 move(0.0);
         auto key = [&](int k) { return shell.key_down(k); };
@@ -95,7 +94,10 @@ void run_planet_viewer(const SkyModel& tables, const NeuralSky* net, const Viewe
         ImGui::Begin("skybake planet", nullptr, ImGuiWindowFlags_AlwaysAutoResize);
         ImGui::SliderFloat("sun elevation", &sun_el, -90.0f, 90.0f, "%.1f deg");
         ImGui::SliderFloat("sun azimuth", &sun_az, -180.0f, 180.0f, "%.1f deg");
-        ImGui::SliderFloat("exposure", &exposure, -10.0f, 10.0f, "%+.1f EV");
+        ImGui::SliderFloat("exposure", &exposure, -16.0f, 16.0f, "%+.1f EV");
+        ImGui::SameLine();
+        if (ImGui::Button("auto"))
+            need_auto_exposure = true;
         int rate = mode;
         if (ImGui::Combo("shading", &rate, "per vertex\0per pixel\0") && rate != mode)
             toggle = true;
@@ -113,19 +115,16 @@ void run_planet_viewer(const SkyModel& tables, const NeuralSky* net, const Viewe
         }
         if (!target || target->width() != w || target->height() != h)
             target = std::make_unique<RenderTarget>(w, h);
-        PlanetView view;
-        view.eye_km = eye;
-        view.forward = fwd;
-        view.up = up;
-        view.fov_x_deg = 90.0;
-        view.width = w;
-        view.height = h;
         // The sun in the local frame of the starting point (the pole), as in `sky render`.
-        view.sun = glm::dvec3(sky::direction_from_angles(float(sun_az * kDeg), float(sun_el * kDeg)));
+        const PlanetView view = planet_viewer_view(eye, yaw, pitch, sun_az, sun_el, w, h);
         PlanetFrameStats st;
         target->bind();
         scenes[mode]->update_mesh(view, &st);
         scenes[mode]->draw(view, false, &st);
+        if (need_auto_exposure) {
+            exposure = model_auto_exposure_ev(target->read_rgb());
+            need_auto_exposure = false;
+        }
         if (screenshot) {
             save_screenshot(o.screenshot, target->read_rgb(), exposure);
             fmt::print(stderr, "wrote {}\n", o.screenshot);
