@@ -95,13 +95,15 @@ void run(const BakeOpts& o, const CLI::App& sub) {
         queries.reset();
     }
 
-    Mesh mesh = load_mesh(o.input);
+    Mesh mesh = load_model(o.input);
     test_fault_point("load");
     const std::vector<glm::vec3> albedo =
         constant_albedo ? std::vector<glm::vec3>(mesh.vertex_count(), albedo_value) : mesh_albedo(mesh, albedo_value);
     const std::string albedo_source =
         constant_albedo ? fmt::format("[{}, {}, {}]", albedo_value.x, albedo_value.y, albedo_value.z)
-                        : (mesh.colors.size() == mesh.vertex_count() ? "vertex-colors" : "[0.8, 0.8, 0.8]");
+                        : !mesh.materials.empty() && !mesh.triangle_parts.empty()
+                            ? "material"
+                            : (mesh.colors.size() == mesh.vertex_count() ? "vertex-colors" : "[0.8, 0.8, 0.8]");
     BakeOptions b;
     b.max_distance = float(o.max_distance);
     b.method = tracer->method();
@@ -171,7 +173,8 @@ void add_prt_bake(CLI::App& group) {
                     "Visibility backend: embree (default on the CPU), brute, cuda or raster (the depth buffer; no "
                     "bounces)");
     sub->add_option("--albedo", o->albedo,
-                    "Linear RGB albedo, one or three numbers in [0, 1] (default: the vertex colours, else 0.8)");
+                    "Linear RGB albedo, one or three numbers in [0, 1] (default: the material's base colour factor x image x "
+                    "vertex colour, as glTF defines it; else the vertex colours; else 0.8)");
     sub->add_option("--model", o->model,
                     "prt (the transfer integral) or shading-coefficient (the seed's A times the unshadowed "
                     "irradiance)")

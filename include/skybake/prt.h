@@ -164,8 +164,12 @@ TransferReport bake_transfer(Mesh& mesh, const SphereRule& rule, VisibilityTrace
                              const TransferOptions& options, std::span<const glm::vec3> albedo, RayQueries* queries,
                              Transfer& out);
 
-// The mesh's albedo for PRT: its vertex colours (RGB) when it has them, else
-// `fallback` for every vertex.
+// The mesh's albedo for PRT, per vertex, as glTF defines the base colour:
+// the material's base colour factor × its base colour image (bilinear at the
+// vertex's UV, repeating; skipped when the file does not load) × the vertex
+// colour (RGB), clamped to [0, 1]. A vertex without a material: its colour, or
+// `fallback` when the mesh has no colours. A vertex of several parts takes the
+// material of the first triangle that uses it.
 std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const glm::vec3& fallback = glm::vec3(0.8f));
 
 // [SECTION] Light ----------------------------------------------------------------------------

@@ -122,14 +122,6 @@ std::uint64_t TransferReduction::reduce(const VisibilityChunk& c) {
     return rays;
 }
 
-std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const glm::vec3& fallback) {
-    std::vector<glm::vec3> albedo(mesh.vertex_count(), fallback);
-    if (mesh.colors.size() == mesh.vertex_count())
-        for (std::size_t v = 0; v < albedo.size(); ++v)
-            albedo[v] = glm::vec3(mesh.colors[v]);
-    return albedo;
-}
-
 namespace {
 
 // Sloan 2002, section 5: each bounce gathers, along every occluded rule
