@@ -23,6 +23,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <tuple>
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
@@ -449,6 +450,18 @@ TEST(ViewCliModels, BadNewSettingsAreOneLine) {
         EXPECT_EQ(r.err_lines(), 1) << bad << ": " << r.err;
         EXPECT_NE(r.err.find("--set"), std::string::npos) << bad << ": " << r.err;
         EXPECT_FALSE(fs::exists(out)) << bad;
+    }
+    // Settings of another shading: refused, naming the shading they apply to.
+    for (const auto& [set, shading, applies] :
+         {std::tuple<const char*, const char*, const char*>{"phong=48", "shading=prt", "shading=dprt"},
+          {"specular=0.5", "shading=ao", "shading=dprt"},
+          {"direction=2", "shading=dprt", "shading=visibility"},
+          {"phong=48", "shading=unshadowed", "shading=dprt"}}) {
+        const auto r = run_cli({"view", obj, "--screenshot", out, "--size", "32x24", "--set", shading, "--set", set});
+        EXPECT_EQ(r.exit_code, 2) << set << ": " << r.err;
+        EXPECT_EQ(r.err_lines(), 1) << set << ": " << r.err;
+        EXPECT_NE(r.err.find(applies), std::string::npos) << set << ": " << r.err;
+        EXPECT_FALSE(fs::exists(out)) << set;
     }
     // A direction beyond the rule: one line from the renderer, exit 1.
     const auto r = run_cli({"view", obj, "--screenshot", out, "--size", "32x24", "--rule", "lebedev:6", "--set",

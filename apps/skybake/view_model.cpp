@@ -153,15 +153,31 @@ void run(const ViewModelOpts& o, const CLI::App& sub) {
                              "--set");
         }
     }
+    // Settings that only one shading reads are refused with another, as the CLI
+    // refuses flags that do not apply (the window can switch shading, but its
+    // starting values then come from the panel).
+    for (const std::string& kv : o.set) {
+        const std::string key = kv.substr(0, kv.find('='));
+        const bool dprt_only = key == "phong" || key == "specular", visibility_only = key == "direction";
+        if ((dprt_only && st.shading != ModelShading::Dprt) ||
+            (visibility_only && st.shading != ModelShading::Visibility))
+            throw UsageError(fmt::format("{} applies to shading={} only; this view has shading={}", key,
+                                         dprt_only ? "dprt" : "visibility", model_shading_name(st.shading)),
+                             "--set");
+    }
     const SphereRule rule = parse_flag("--rule", [&] { return parse_rule(o.rule); });
     if (rule.kind == RuleKind::Phong)
         throw UsageError(fmt::format("--rule {} is a Phong rule; use a sphere rule (lebedev:2030, ...)", rule.spec),
                          "--rule");
     // The network (--model) and the reference sky: that of --preset/--atmosphere, or the network's own tables.
+    // The reference sky's tables take seconds (the optical lengths): they are
+    // built only where they are drawn, the window (its panel offers both skies)
+    // or sky=reference, not for a headless frame of the network.
     std::optional<SkySource> network, reference;
     if (o.model.active()) {
         NeuralSky net = o.model.load(sub, o.atm);
-        reference.emplace(SkySource::reference(neural_reference_model(net)));
+        if (window || !sky_network)
+            reference.emplace(SkySource::reference(neural_reference_model(net)));
         network.emplace(SkySource::network(std::move(net)));
     } else {
         reference.emplace(SkySource::reference(SkyModel(o.atm.load(sub))));

@@ -101,3 +101,27 @@ def test_missing_and_broken_files(tmp):
     with pytest.raises(skybake.Error, match="cannot write"):
         skybake.save_mesh(tmp / "out.xyz", skybake.Mesh(TRIANGLE, ONE))
     assert not (tmp / "out.xyz").exists()
+
+
+def test_nan_and_negative_values_raise(tmp_path):
+    # docs/python.md: a NaN raises, naming the argument; nothing is written.
+    m = skybake.Mesh(TRIANGLE, ONE)
+    for bad in (np.array([0.5, np.nan, 0.5], np.float32), np.array([0.5, np.inf, 0.5], np.float32)):
+        with pytest.raises(skybake.Error) as info:
+            m.set_attribute("ao", bad)
+        assert info.value.where == "values"
+    with pytest.raises(skybake.Error) as info:
+        m.set_attribute("bent", np.full((3, 3), np.nan, np.float32))
+    assert info.value.where == "values"
+    img = np.zeros((4, 4, 3), np.float32)
+    img[1, 2, 0] = np.nan
+    for name in ("a.png", "a.exr"):
+        with pytest.raises(skybake.Error) as info:
+            skybake.save_image(tmp_path / name, img)
+        assert info.value.where == "rgb"
+        assert not (tmp_path / name).exists()
+    with pytest.raises(skybake.Error) as info:
+        skybake.set_threads(-1)
+    assert info.value.where == "count"
+    skybake.set_threads(0)
+    assert skybake.threads() >= 1

@@ -209,8 +209,22 @@ ShLight light_from_json(std::string_view text, const std::string& name) {
         };
         for (const auto& v : c)
             l.coeffs.push_back(vec(v));
-        l.sun_direction = vec(j.at("sun_direction"));
+        // The sun: a direction (any length but zero) and an
+        // irradiance ≥ 0 per channel (zero: no sun).
+        const glm::vec3 d = vec(j.at("sun_direction"));
+        const float length = std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+        if (!(length > 1e-6f) || !std::isfinite(length))
+            throw Error(fmt::format("{}: sun_direction {} is not a direction (zero length)", name,
+                                    j.at("sun_direction").dump()),
+                        "light");
+        // Stored unit; a direction already unit to float rounding is kept as
+        // written, so that a file read and written again is unchanged.
+        l.sun_direction = std::abs(length - 1.0f) > 1e-5f ? d / length : d;
         l.sun_irradiance = vec(j.at("sun_irradiance"));
+        if (l.sun_irradiance.x < 0.0f || l.sun_irradiance.y < 0.0f || l.sun_irradiance.z < 0.0f)
+            throw Error(fmt::format("{}: sun_irradiance {} is negative; it is ≥ 0 per channel (0: no sun)", name,
+                                    j.at("sun_irradiance").dump()),
+                        "light");
     } catch (const nlohmann::json::exception& e) {
         throw Error(fmt::format("{} is not a valid light file: {}", name, e.what()), "light");
     } catch (const Error& e) {

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <tuple>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -134,4 +135,36 @@ TEST(PrtFile, RadianceHdrMapIsALight) {
 }
 
 } // namespace
+} // namespace skybake
+
+namespace skybake {
+
+// A light file's sun: a negative irradiance or a zero direction is refused
+// (naming the light), a direction of any other length is stored unit.
+TEST(PrtFile, LightFileSunMustBePhysical) {
+    const auto light = [](const std::string& dir, const std::string& irr) {
+        return fmt::format(R"({{"format":"skybake-sh-light","version":1,"order":0,"coefficients":[[1,1,1]],)"
+                           R"("sun_direction":{},"sun_irradiance":{}}})",
+                           dir, irr);
+    };
+    const ShLight ok = light_from_json(light("[0,3,4]", "[1,2,0]"), "ok.json");
+    EXPECT_FLOAT_EQ(ok.sun_direction.y, 0.6f);
+    EXPECT_FLOAT_EQ(ok.sun_direction.z, 0.8f);
+    EXPECT_EQ(ok.sun_irradiance, glm::vec3(1, 2, 0));
+    for (const auto& [dir, irr, words] :
+         {std::tuple<std::string, std::string, std::string>{"[0,1,0]", "[1,-0.5,1]", "negative"},
+          {"[0,0,0]", "[1,1,1]", "zero length"},
+          {"[0,0,0]", "[0,0,0]", "zero length"},
+          {"[1e-30,0,0]", "[1,1,1]", "zero length"}}) {
+        try {
+            light_from_json(light(dir, irr), "bad.json");
+            ADD_FAILURE() << dir << " " << irr << " was accepted";
+        } catch (const Error& e) {
+            EXPECT_EQ(e.where(), "light");
+            EXPECT_NE(e.message().find(words), std::string::npos) << e.message();
+            EXPECT_NE(e.message().find("bad.json"), std::string::npos) << e.message();
+        }
+    }
+}
+
 } // namespace skybake
