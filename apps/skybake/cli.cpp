@@ -4,6 +4,15 @@
 
 namespace skybake::cli {
 
+Mesh load_model(const std::string& path) {
+    ImportReport report;
+    Mesh mesh = load_mesh(path, &report);
+    for (const std::string& t : report.missing_textures)
+        info("warning: {}: texture '{}' not found (looked beside the model too); its material keeps its colour",
+             path, t);
+    return mesh;
+}
+
 void parse_size(const std::string& text, int& width, int& height, const char* flag) {
     const auto x = text.find('x');
     auto parse = [&](std::string_view s, int& out) {

@@ -15,6 +15,7 @@
 
 #include "skybake/core.h"
 #include "skybake/error.h"
+#include "skybake/mesh.h"
 
 namespace skybake::cli {
 
@@ -32,6 +33,10 @@ void info(fmt::format_string<Args...> f, Args&&... args) {
     if (!skybake::quiet())
         fmt::print(stderr, "{}\n", fmt::format(f, std::forward<Args>(args)...));
 }
+
+// load_mesh(), with a warning line for each texture the model names that was
+// not found (the material keeps its colour): every command that reads a model.
+Mesh load_model(const std::string& path);
 
 // Parses "WxH" (e.g. "1280x720"); throws skybake::Error naming the flag.
 void parse_size(const std::string& text, int& width, int& height, const char* flag);

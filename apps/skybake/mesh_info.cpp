@@ -58,6 +58,7 @@ void run(const MeshInfoOptions& o) {
                     {"uv_sets", mesh.texcoords.size()},
                     {"materials", mesh.materials.size()},
                     {"textured_materials", textured},
+                    {"missing_textures", rep.missing_textures},
                     {"parts", mesh.parts.size()},
                     {"named_parts", named},
                     {"output_keeps", output_keeps(mesh, gltf2)},
@@ -80,6 +81,8 @@ void run(const MeshInfoOptions& o) {
         uvs += fmt::format("{}TEXCOORD_{}", k ? ", " : "", k);
     fmt::print("uv sets     {}\n", uvs.empty() ? "none" : uvs);
     fmt::print("materials   {} ({} with a base colour image)\n", mesh.materials.size(), textured);
+    for (const std::string& t : rep.missing_textures)
+        fmt::print("missing     {} (not found, looked beside the model too)\n", t);
     fmt::print("parts       {} ({} named)\n", mesh.parts.size(), named);
     fmt::print("output      keeps {}\n", output_keeps(mesh, gltf2));
     fmt::print("bounds      min ({:.6g}, {:.6g}, {:.6g})  max ({:.6g}, {:.6g}, {:.6g})\n", b.min.x, b.min.y, b.min.z,

@@ -117,6 +117,11 @@ struct ImportReport {
     std::size_t degenerate_triangles = 0; // zero-area triangles skipped
     std::size_t non_triangles = 0;   // points and lines skipped
     bool normals_present = false;    // the file had usable normals for every vertex
+    // Texture files the model names that were not found (as the file spells
+    // them); their materials keep their colour but no texture. A path written
+    // on another machine (backslashes, "D:\\...") is looked for beside the
+    // model first: its trailing folders under the model's folder and the one above.
+    std::vector<std::string> missing_textures;
 };
 
 // Loads any format Assimp reads (OBJ, STL, OFF, FBX, DAE, 3DS, ...), glTF

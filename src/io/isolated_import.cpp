@@ -132,6 +132,9 @@ std::string serialise(const RawImport& r) {
     w.pod(std::uint64_t(r.report.source_meshes));
     w.pod(std::uint64_t(r.report.degenerate_triangles));
     w.pod(std::uint64_t(r.report.non_triangles));
+    w.pod(std::uint64_t(r.report.missing_textures.size()));
+    for (const std::string& t : r.report.missing_textures)
+        w.str(t);
     return std::move(w.buf);
 }
 
@@ -187,6 +190,11 @@ RawImport deserialise(const std::string& buf, const std::string& where) {
     r.report.source_meshes = rd.pod<std::uint64_t>();
     r.report.degenerate_triangles = rd.pod<std::uint64_t>();
     r.report.non_triangles = rd.pod<std::uint64_t>();
+    const auto missing = rd.pod<std::uint64_t>();
+    if (missing > materials)
+        throw Error("the isolated importer sent an unreadable result", where);
+    for (std::uint64_t i = 0; i < missing; ++i)
+        r.report.missing_textures.push_back(rd.str());
     return r;
 }
 

@@ -556,29 +556,31 @@ void write_glb(const std::filesystem::path& tmp, const Mesh& mesh) {
     model.asset.generator = "skybake";
     model.buffers.resize(1);
 
-    // Materials, with their base colour images referenced beside the output.
+    // Materials, with their base colour and occlusion images referenced beside
+    // the output: one image and texture per file, however many materials use it.
+    std::map<std::string, int> texture_of;
+    const auto texture_for = [&](const std::string& file) {
+        const std::string uri = image_uri(file, tmp.parent_path());
+        if (auto it = texture_of.find(uri); it != texture_of.end())
+            return it->second;
+        tinygltf::Image image;
+        image.uri = uri;
+        model.images.push_back(image);
+        tinygltf::Texture texture;
+        texture.source = int(model.images.size() - 1);
+        model.textures.push_back(texture);
+        return texture_of[uri] = int(model.textures.size() - 1);
+    };
     for (const MeshMaterial& m : mesh.materials) {
         tinygltf::Material gm;
         gm.name = m.name;
         gm.pbrMetallicRoughness.baseColorFactor = {m.base_color.r, m.base_color.g, m.base_color.b, m.base_color.a};
         if (!m.base_color_texture.empty()) {
-            tinygltf::Image image;
-            image.uri = image_uri(m.base_color_texture, tmp.parent_path());
-            model.images.push_back(image);
-            tinygltf::Texture texture;
-            texture.source = int(model.images.size() - 1);
-            model.textures.push_back(texture);
-            gm.pbrMetallicRoughness.baseColorTexture.index = int(model.textures.size() - 1);
+            gm.pbrMetallicRoughness.baseColorTexture.index = texture_for(m.base_color_texture);
             gm.pbrMetallicRoughness.baseColorTexture.texCoord = m.base_color_texcoord;
         }
         if (!m.occlusion_texture.empty()) {
-            tinygltf::Image image;
-            image.uri = image_uri(m.occlusion_texture, tmp.parent_path());
-            model.images.push_back(image);
-            tinygltf::Texture texture;
-            texture.source = int(model.images.size() - 1);
-            model.textures.push_back(texture);
-            gm.occlusionTexture.index = int(model.textures.size() - 1);
+            gm.occlusionTexture.index = texture_for(m.occlusion_texture);
             gm.occlusionTexture.texCoord = m.occlusion_texcoord;
         }
         model.materials.push_back(gm);

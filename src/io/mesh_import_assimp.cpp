@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "io/mesh_internal.h"
+#include "io/texture_path.h"
 #include "skybake/error.h"
 
 namespace skybake::io {
@@ -69,8 +70,15 @@ struct Flattener {
             unsigned uv = 0;
             if (am->GetTexture(type, 0, &path, nullptr, &uv) != AI_SUCCESS || path.length == 0)
                 continue;
-            if (path.C_Str()[0] != '*') // "*0": embedded in the file, not carried
-                mm.base_color_texture = (source_dir / path.C_Str()).lexically_normal().string();
+            // "*0": embedded in the file, not carried. A path written on another
+            // machine is looked for beside the model (io/texture_path.h); one
+            // that is nowhere is reported, and the material keeps its colour.
+            if (path.C_Str()[0] != '*') {
+                if (const auto found = find_texture(path.C_Str(), source_dir))
+                    mm.base_color_texture = found->string();
+                else
+                    out.report.missing_textures.push_back(path.C_Str());
+            }
             mm.base_color_texcoord = int(uv);
             break;
         }

@@ -1,0 +1,109 @@
+// Texture paths written on another machine (backslashes, drive letters,
+// absolute paths): found beside the model, or reported as missing; never
+// written out as they came. Labelled "io".
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "io/texture_path.h"
+#include "skybake/files.h"
+#include "skybake/mesh.h"
+#include "core/test_paths.h"
+
+using namespace skybake;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path kModels = skybake::test::assimp_models();
+
+fs::path temp_folder(const std::string& name) {
+    const fs::path dir = fs::temp_directory_path() / ("skybake-texpath-test-" + std::to_string(::getpid())) / name;
+    fs::create_directories(dir);
+    return dir;
+}
+
+} // namespace
+
+TEST(TexturePath, FoundAsWrittenOrByItsTrailingFolders) {
+    const fs::path root = temp_folder("find");
+    fs::create_directories(root / "models" / "FBX");
+    fs::create_directories(root / "models" / "OBJ");
+    fs::create_directories(root / "models" / "FBX" / "tex");
+    std::ofstream(root / "models" / "OBJ" / "wood.jpg") << "x";
+    std::ofstream(root / "models" / "FBX" / "tex" / "paint.png") << "x";
+    const fs::path dir = root / "models" / "FBX";
+    // As written, relative to the model, with either separator.
+    EXPECT_EQ(io::find_texture("tex/paint.png", dir), (dir / "tex" / "paint.png").lexically_normal());
+    EXPECT_EQ(io::find_texture("tex\\paint.png", dir), (dir / "tex" / "paint.png").lexically_normal());
+    EXPECT_EQ(io::find_texture("..\\OBJ\\wood.jpg", dir), (root / "models" / "OBJ" / "wood.jpg").lexically_normal());
+    // Absolute on another machine: the trailing folders, under the model's folder or the one above.
+    EXPECT_EQ(io::find_texture("D:\\work\\models\\OBJ\\wood.jpg", dir),
+              (root / "models" / "OBJ" / "wood.jpg").lexically_normal());
+    EXPECT_EQ(io::find_texture("C:/art/tex/paint.png", dir), (dir / "tex" / "paint.png").lexically_normal());
+    EXPECT_EQ(io::find_texture("/home/someone/paint.png", dir), std::nullopt); // not in a folder looked at
+    EXPECT_EQ(io::find_texture("/home/someone/tex/paint.png", dir), (dir / "tex" / "paint.png").lexically_normal());
+    // Nowhere.
+    EXPECT_EQ(io::find_texture("D:\\work\\missing.jpg", dir), std::nullopt);
+    EXPECT_EQ(io::find_texture("", dir), std::nullopt);
+    EXPECT_EQ(io::find_texture("tex/paint.png", fs::path()), std::nullopt);
+    // An absolute path that exists here is taken as it is.
+    const fs::path abs = fs::absolute(dir / "tex" / "paint.png");
+    EXPECT_EQ(io::find_texture(abs.string(), fs::path()), abs.lexically_normal());
+}
+
+// spider.fbx names its images as "D:\projects\assimp_int\test\models\OBJ\*.jpg";
+// the images ship in models/OBJ/. Each is found, and the .glb written from it
+// references files that exist, with forward slashes only.
+TEST(TexturePath, SpiderFbxTexturesAreFoundAndWrittenPortably) {
+    const fs::path spider = kModels / "FBX" / "spider.fbx";
+    ImportReport report;
+    const Mesh mesh = load_mesh(spider, &report);
+    EXPECT_TRUE(report.missing_textures.empty()) << report.missing_textures.front();
+    std::size_t textured = 0;
+    for (const MeshMaterial& m : mesh.materials) {
+        if (m.base_color_texture.empty())
+            continue;
+        ++textured;
+        EXPECT_EQ(m.base_color_texture.find('\\'), std::string::npos) << m.base_color_texture;
+        EXPECT_TRUE(fs::is_regular_file(m.base_color_texture)) << m.base_color_texture;
+        EXPECT_EQ(fs::path(m.base_color_texture).parent_path().filename(), "OBJ") << m.base_color_texture;
+    }
+    EXPECT_GE(textured, 3u);
+
+    const fs::path out = temp_folder("spider") / "spider.glb";
+    save_mesh(out, mesh);
+    const std::string data = read_file(out);
+    std::uint32_t len;
+    std::memcpy(&len, data.data() + 12, 4);
+    const auto j = nlohmann::json::parse(data.substr(20, len));
+    ASSERT_TRUE(j.contains("images"));
+    std::set<std::string> uris;
+    for (const auto& image : j["images"]) {
+        const std::string uri = image["uri"].get<std::string>();
+        EXPECT_EQ(uri.find('\\'), std::string::npos) << uri;
+        EXPECT_EQ(uri.find(':'), std::string::npos) << uri;
+        EXPECT_TRUE(fs::is_regular_file(out.parent_path() / uri)) << uri;
+        EXPECT_TRUE(uris.insert(uri).second) << "one image per file: " << uri << " twice";
+    }
+    EXPECT_EQ(j["textures"].size(), j["images"].size());
+}
+
+// Moved away from its images: each is reported (as the file spells it), the
+// materials keep their colours and carry no texture.
+TEST(TexturePath, MissingTexturesAreReportedNotWritten) {
+    const fs::path dir = temp_folder("alone");
+    const fs::path spider = dir / "spider.fbx";
+    fs::copy_file(kModels / "FBX" / "spider.fbx", spider, fs::copy_options::overwrite_existing);
+    ImportReport report;
+    const Mesh mesh = load_mesh(spider, &report);
+    ASSERT_GE(report.missing_textures.size(), 3u);
+    for (const std::string& t : report.missing_textures)
+        EXPECT_NE(t.find(".jpg"), std::string::npos) << t;
+    for (const MeshMaterial& m : mesh.materials)
+        EXPECT_TRUE(m.base_color_texture.empty()) << m.base_color_texture;
+}
