@@ -76,8 +76,9 @@ struct Flattener {
             if (path.C_Str()[0] != '*') {
                 if (const auto found = find_texture(path.C_Str(), source_dir))
                     mm.base_color_texture = found->string();
-                else
-                    out.report.missing_textures.push_back(path.C_Str());
+                else if (std::find(out.report.missing_textures.begin(), out.report.missing_textures.end(),
+                                   path.C_Str()) == out.report.missing_textures.end())
+                    out.report.missing_textures.push_back(path.C_Str()); // once per file
             }
             mm.base_color_texcoord = int(uv);
             break;
@@ -237,7 +238,7 @@ RawImport read_assimp_here(const void* data, std::size_t size, const std::string
 
     Flattener flat{scene, limits, where, {}};
     if (path)
-        flat.source_dir = path->parent_path();
+        flat.source_dir = path->has_parent_path() ? path->parent_path() : std::filesystem::path(".");
     flat.out.report.format = extension_hint;
     flat.visit(scene->mRootNode, aiMatrix4x4(), 0);
     if (flat.any_missing_normals)

@@ -102,8 +102,35 @@ TEST(TexturePath, MissingTexturesAreReportedNotWritten) {
     ImportReport report;
     const Mesh mesh = load_mesh(spider, &report);
     ASSERT_GE(report.missing_textures.size(), 3u);
-    for (const std::string& t : report.missing_textures)
+    std::set<std::string> once;
+    for (const std::string& t : report.missing_textures) {
         EXPECT_NE(t.find(".jpg"), std::string::npos) << t;
+        EXPECT_TRUE(once.insert(t).second) << t << " reported twice";
+    }
     for (const MeshMaterial& m : mesh.materials)
         EXPECT_TRUE(m.base_color_texture.empty()) << m.base_color_texture;
+}
+
+// A model named by its bare file name, from its own folder: its images are
+// beside it (the folder is ".", not none).
+TEST(TexturePath, ModelInTheCurrentFolderFindsItsImages) {
+    const fs::path dir = temp_folder("here");
+    for (const auto& e : fs::directory_iterator(kModels / "glTF" / "CesiumMilkTruck"))
+        fs::copy_file(e.path(), dir / e.path().filename(), fs::copy_options::overwrite_existing);
+    const fs::path before = fs::current_path();
+    fs::current_path(dir);
+    ImportReport report;
+    Mesh mesh;
+    try {
+        mesh = load_mesh("CesiumMilkTruck.gltf", &report);
+    } catch (...) {
+        fs::current_path(before);
+        throw;
+    }
+    fs::current_path(before);
+    EXPECT_TRUE(report.missing_textures.empty()) << report.missing_textures.front();
+    std::size_t textured = 0;
+    for (const MeshMaterial& m : mesh.materials)
+        textured += !m.base_color_texture.empty();
+    EXPECT_EQ(textured, 2u);
 }
