@@ -239,8 +239,13 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
         std::vector<Image> base_colors(mesh.materials.size());
         for (std::size_t m = 0; m < mesh.materials.size(); ++m) {
             std::error_code ec;
-            const std::string& image = mesh.materials[m].base_color_texture;
-            if (!image.empty() && std::filesystem::is_regular_file(image, ec))
+            const MeshMaterial& mm = mesh.materials[m];
+            const std::string& image = mm.base_color_texture;
+            if (!mm.base_color_image.empty())
+                base_colors[m] = load_image_from_memory(mm.base_color_image.data(), mm.base_color_image.size(),
+                                                        mm.base_color_image_type == "image/jpeg" ? "jpg" : "png",
+                                                        o.input);
+            else if (!image.empty() && std::filesystem::is_regular_file(image, ec))
                 base_colors[m] = load_image(image);
         }
         save_image(files.stage(o.preview), render_texture_preview(mesh, *texture, o.uv, base_colors, preview),

@@ -41,8 +41,13 @@ struct MeshMaterial {
     glm::vec4 base_color{1.0f}; // linear RGBA factor
     // The base colour image: a path, relative to the current folder or
     // absolute, as resolved against the source file's folder; empty if none
-    // (or embedded in the source, which is not carried).
+    // or embedded.
     std::string base_color_texture;
+    // An embedded base colour image (a .glb's bufferView, a data URI): the
+    // encoded file's bytes and its MIME type ("image/png", "image/jpeg").
+    // A .glb that save_mesh() writes embeds this, or the file above.
+    std::vector<unsigned char> base_color_image;
+    std::string base_color_image_type;
     int base_color_texcoord = 0; // the UV set (Mesh::texcoords) the image is mapped with
     // An ambient occlusion image (glTF occlusionTexture, read from its red
     // channel), a path as base_color_texture; empty if none.

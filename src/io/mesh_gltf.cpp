@@ -7,8 +7,11 @@
 // is read; tinygltf's own checks are not relied upon.
 #include <cmath>
 #include <cstring>
+#include <cctype>
 #include <fstream>
+#include <functional>
 #include <map>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <glm/gtc/matrix_inverse.hpp>
@@ -28,6 +31,7 @@
 
 #include "io/mesh_internal.h"
 #include "skybake/error.h"
+#include "skybake/files.h"
 
 namespace skybake::io {
 
@@ -80,7 +84,16 @@ bool fs_write(std::string* err, const std::string&, const std::vector<unsigned c
 }
 
 // Images are not needed for lighting; skip decoding them.
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+// Images are not decoded here; the bytes of an embedded one (a bufferView or
+// a data URI) are kept, by image index, for the material that uses it.
+struct EmbeddedImages {
+    std::map<int, std::vector<unsigned char>> bytes;
+};
+
+bool keep_embedded_image(tinygltf::Image* image, const int index, std::string*, std::string*, int, int,
+                         const unsigned char* data, int size, void* user) {
+    if (user && data && size > 0 && (image->bufferView >= 0 || image->uri.rfind("data:", 0) == 0))
+        static_cast<EmbeddedImages*>(user)->bytes[index].assign(data, data + size);
     return true;
 }
 
@@ -404,8 +417,15 @@ public:
         if (t >= 0 && std::size_t(t) < model_.textures.size()) {
             const int i = model_.textures[std::size_t(t)].source;
             if (i >= 0 && std::size_t(i) < model_.images.size()) {
-                const std::string& uri = model_.images[std::size_t(i)].uri;
-                if (!uri.empty() && uri.rfind("data:", 0) != 0 && !base_dir_.empty()) {
+                const tinygltf::Image& image = model_.images[std::size_t(i)];
+                const std::string& uri = image.uri;
+                if (embedded_) {
+                    if (auto it = embedded_->bytes.find(i); it != embedded_->bytes.end()) {
+                        mm.base_color_image = it->second;
+                        mm.base_color_image_type = image.mimeType;
+                    }
+                }
+                if (mm.base_color_image.empty() && !uri.empty() && uri.rfind("data:", 0) != 0 && !base_dir_.empty()) {
                     const std::string decoded = percent_decode(uri);
                     mm.base_color_texture = (std::filesystem::path(base_dir_) / decoded).lexically_normal().string();
                 }
@@ -423,6 +443,7 @@ public:
     bool any_colors = false;
 
     std::string base_dir_;
+    const EmbeddedImages* embedded_ = nullptr;
 
 private:
     std::map<int, int> materials_;
@@ -438,7 +459,8 @@ RawImport read_gltf(const void* data, std::size_t size, bool binary, const std::
     tinygltf::TinyGLTF loader;
     FsContext fs_ctx{base_dir, limits.max_file_bytes};
     loader.SetFsCallbacks({fs_exists, fs_expand, fs_read, fs_write, &fs_ctx});
-    loader.SetImageLoader(skip_image, nullptr);
+    EmbeddedImages embedded;
+    loader.SetImageLoader(keep_embedded_image, &embedded);
     tinygltf::Model model;
     std::string err, warn;
     const auto* bytes = static_cast<const unsigned char*>(data);
@@ -461,6 +483,7 @@ RawImport read_gltf(const void* data, std::size_t size, bool binary, const std::
 
     Reader reader(model, where, limits);
     reader.base_dir_ = base_dir;
+    reader.embedded_ = &embedded;
     reader.out.report.format = binary ? "glb" : "gltf";
     std::vector<int> roots;
     if (!model.scenes.empty()) {
@@ -556,31 +579,65 @@ void write_glb(const std::filesystem::path& tmp, const Mesh& mesh) {
     model.asset.generator = "skybake";
     model.buffers.resize(1);
 
-    // Materials, with their base colour and occlusion images referenced beside
-    // the output: one image and texture per file, however many materials use it.
+    // Materials. A base colour image is embedded (the material's own bytes,
+    // or its file when that is a PNG or JPEG), so that the .glb travels whole;
+    // other images (the occlusion image a bake writes beside the output, a
+    // TGA) are referenced from the output's folder. One image and texture per
+    // file or embedded image, however many materials use it.
     std::map<std::string, int> texture_of;
-    const auto texture_for = [&](const std::string& file) {
-        const std::string uri = image_uri(file, tmp.parent_path());
-        if (auto it = texture_of.find(uri); it != texture_of.end())
-            return it->second;
-        tinygltf::Image image;
-        image.uri = uri;
-        model.images.push_back(image);
+    const auto new_texture = [&](tinygltf::Image image) {
+        model.images.push_back(std::move(image));
         tinygltf::Texture texture;
         texture.source = int(model.images.size() - 1);
         model.textures.push_back(texture);
-        return texture_of[uri] = int(model.textures.size() - 1);
+        return int(model.textures.size() - 1);
+    };
+    const auto referenced = [&](const std::string& file) {
+        const std::string uri = image_uri(file, tmp.parent_path());
+        if (auto it = texture_of.find("uri:" + uri); it != texture_of.end())
+            return it->second;
+        tinygltf::Image image;
+        image.uri = uri;
+        return texture_of["uri:" + uri] = new_texture(std::move(image));
+    };
+    const auto embedded = [&](const std::vector<unsigned char>& bytes, const std::string& mime) {
+        const std::string key =
+            fmt::format("bytes:{}:{}:{}", mime, bytes.size(),
+                        std::hash<std::string_view>{}(std::string_view(reinterpret_cast<const char*>(bytes.data()),
+                                                                       bytes.size())));
+        if (auto it = texture_of.find(key); it != texture_of.end())
+            return it->second;
+        tinygltf::Image image;
+        image.mimeType = mime;
+        image.bufferView = add_view(model, bytes.data(), bytes.size(), 0);
+        return texture_of[key] = new_texture(std::move(image));
+    };
+    const auto base_color = [&](const MeshMaterial& m) {
+        if (!m.base_color_image.empty() && (m.base_color_image_type == "image/png" ||
+                                            m.base_color_image_type == "image/jpeg"))
+            return embedded(m.base_color_image, m.base_color_image_type);
+        std::string ext = std::filesystem::path(m.base_color_texture).extension().string();
+        for (char& c : ext)
+            c = char(std::tolower(static_cast<unsigned char>(c)));
+        std::error_code ec;
+        if ((ext == ".png" || ext == ".jpg" || ext == ".jpeg") &&
+            std::filesystem::is_regular_file(m.base_color_texture, ec)) {
+            const std::string data = read_file(m.base_color_texture);
+            return embedded(std::vector<unsigned char>(data.begin(), data.end()),
+                            ext == ".png" ? "image/png" : "image/jpeg");
+        }
+        return referenced(m.base_color_texture);
     };
     for (const MeshMaterial& m : mesh.materials) {
         tinygltf::Material gm;
         gm.name = m.name;
         gm.pbrMetallicRoughness.baseColorFactor = {m.base_color.r, m.base_color.g, m.base_color.b, m.base_color.a};
-        if (!m.base_color_texture.empty()) {
-            gm.pbrMetallicRoughness.baseColorTexture.index = texture_for(m.base_color_texture);
+        if (!m.base_color_texture.empty() || !m.base_color_image.empty()) {
+            gm.pbrMetallicRoughness.baseColorTexture.index = base_color(m);
             gm.pbrMetallicRoughness.baseColorTexture.texCoord = m.base_color_texcoord;
         }
         if (!m.occlusion_texture.empty()) {
-            gm.occlusionTexture.index = texture_for(m.occlusion_texture);
+            gm.occlusionTexture.index = referenced(m.occlusion_texture);
             gm.occlusionTexture.texCoord = m.occlusion_texcoord;
         }
         model.materials.push_back(gm);

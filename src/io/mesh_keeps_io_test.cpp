@@ -58,13 +58,16 @@ TEST(MeshKeeps, CesiumMilkTruckKeepsTextureUvsAndNodeNames) {
     for (const auto& uv : mesh.texcoords[0])
         ASSERT_TRUE(uv.x > -1e-3f && uv.x < 1.001f && uv.y > -1e-3f && uv.y < 1.001f) << uv.x << " " << uv.y;
 
-    // Written as .glb elsewhere: the texture is referenced from there, UVs and names come back.
+    // Written as .glb elsewhere: the texture is embedded (it travels with the
+    // file), UVs and names come back.
     const fs::path out = temp("truck.glb");
     save_mesh(out, mesh);
     const Json j = glb_json(out);
     ASSERT_TRUE(j.contains("images"));
-    EXPECT_TRUE(fs::is_regular_file(out.parent_path() / j["images"][0]["uri"].get<std::string>()))
-        << j["images"][0]["uri"];
+    ASSERT_EQ(j["images"].size(), 1u) << "one image for the materials that share it";
+    EXPECT_FALSE(j["images"][0].contains("uri"));
+    EXPECT_EQ(j["images"][0]["mimeType"], "image/png");
+    EXPECT_TRUE(j["images"][0].contains("bufferView"));
     EXPECT_TRUE(j["meshes"][0]["primitives"][0]["attributes"].contains("TEXCOORD_0"));
     std::set<std::string> written;
     for (const auto& n : j["nodes"])
@@ -79,7 +82,10 @@ TEST(MeshKeeps, CesiumMilkTruckKeepsTextureUvsAndNodeNames) {
     ASSERT_EQ(back.materials.size(), mesh.materials.size());
     for (std::size_t i = 0; i < back.materials.size(); ++i) {
         EXPECT_EQ(back.materials[i].base_color, mesh.materials[i].base_color);
-        EXPECT_EQ(back.materials[i].base_color_texture.empty(), mesh.materials[i].base_color_texture.empty());
+        EXPECT_EQ(back.materials[i].base_color_image.empty(), mesh.materials[i].base_color_texture.empty());
+        if (!mesh.materials[i].base_color_texture.empty()) // the file's bytes, as they were
+            EXPECT_EQ(std::string(back.materials[i].base_color_image.begin(), back.materials[i].base_color_image.end()),
+                      read_file(mesh.materials[i].base_color_texture));
     }
 }
 

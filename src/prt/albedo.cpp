@@ -60,12 +60,16 @@ std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const glm::vec3& fallback) 
     // Each material's image, loaded once; one that does not load is left out.
     std::vector<Image> images(mesh.materials.size());
     for (std::size_t m = 0; m < mesh.materials.size(); ++m) {
-        const std::string& file = mesh.materials[m].base_color_texture;
+        const MeshMaterial& mm = mesh.materials[m];
+        const std::string& file = mm.base_color_texture;
         std::error_code ec;
-        if (file.empty() || !std::filesystem::is_regular_file(file, ec))
-            continue;
         try {
-            images[m] = load_image(file);
+            if (!mm.base_color_image.empty())
+                images[m] = load_image_from_memory(mm.base_color_image.data(), mm.base_color_image.size(),
+                                                   mm.base_color_image_type == "image/jpeg" ? "jpg" : "png",
+                                                   mm.name.empty() ? "embedded image" : mm.name);
+            else if (!file.empty() && std::filesystem::is_regular_file(file, ec))
+                images[m] = load_image(file);
         } catch (const Error&) {
             images[m] = Image();
         }

@@ -80,6 +80,13 @@ TEST(MeshAlbedo, TexturedSampleModelIsNotGrey) {
     }
     EXPECT_GT(hi.x - lo.x + hi.y - lo.y + hi.z - lo.z, 0.1f) << "the same colour everywhere";
     EXPECT_NE(a[0], glm::vec3(0.8f));
+    // Written as .glb (the image embedded) and moved away from the image: the same albedo.
+    const fs::path dir = fs::temp_directory_path() / ("skybake-albedo-glb-" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    save_mesh(dir / "truck.glb", m);
+    const Mesh back = load_mesh(dir / "truck.glb");
+    EXPECT_EQ(mesh_albedo(back), a);
+    fs::remove_all(dir);
 }
 
 } // namespace
