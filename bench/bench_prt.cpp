@@ -112,7 +112,10 @@ void BM_SkySh(benchmark::State& state) {
     static const SkySource reference = SkySource::reference(SkyModel(atmosphere_preset("earth")));
     static const SkySource network = SkySource::network(random_net());
     const SkySource& sky = state.range(0) == 0 ? reference : network;
-    const SkyProjector projector(4, parse_rule(state.range(1) == 0 ? "lebedev:590" : "lebedev:2030"));
+    // 0: lebedev:590, 1: lebedev:2030 (the former default), 2: the default (kSkyLightRule, split at the horizon).
+    const char* const rules[] = {"lebedev:590", "lebedev:2030", kSkyLightRule};
+    const char* const spec = rules[state.range(1)];
+    const SkyProjector projector(4, parse_rule(spec));
     SkyLightSettings s;
     double angle = 0.0;
     for (auto _ : state) {
@@ -120,7 +123,7 @@ void BM_SkySh(benchmark::State& state) {
         const ShLight l = projector.project(sky, s);
         benchmark::DoNotOptimize(l.coeffs.data());
     }
-    state.SetLabel(fmt::format("{} {}", sky.method_name(), state.range(1) == 0 ? "lebedev:590" : "lebedev:2030"));
+    state.SetLabel(fmt::format("{} {}", sky.method_name(), spec));
 }
 
 void BM_Relight(benchmark::State& state) {
@@ -151,6 +154,8 @@ BENCHMARK(BM_SkySh)
     ->Args({1, 0})
     ->Args({0, 1})
     ->Args({1, 1})
+    ->Args({0, 2})
+    ->Args({1, 2})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_Relight)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -23,7 +23,7 @@ namespace {
 struct RelightOpts {
     AtmosphereFlags atm;
     ModelFlag model;
-    std::string input, output, light = "sky", rule = "lebedev:2030", size = "960x720", view = "35,30",
+    std::string input, output, light = "sky", rule = kSkyLightRule, size = "960x720", view = "35,30",
                                exposure = "auto";
     double elevation = 30.0, azimuth = 0.0, altitude = 0.0, radiance = 1.0, glossy = 0.0, specular = 0.3;
     bool no_sun = false, json = false;

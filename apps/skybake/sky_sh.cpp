@@ -17,7 +17,7 @@ void add_sky_sh(CLI::App& group) {
     struct Opts {
         AtmosphereFlags atm;
         ModelFlag model;
-        std::string output, rule = "lebedev:2030", device = "cpu";
+        std::string output, rule = kSkyLightRule, device = "cpu";
         double elevation = 30.0, azimuth = 0.0, altitude = 0.0;
         int order = 3;
         bool json = false;
@@ -45,8 +45,8 @@ void add_sky_sh(CLI::App& group) {
         check_output_path(o->output, {".json"}, "--output");
         const SphereRule rule = parse_flag("--rule", [&] { return parse_rule(o->rule); });
         if (rule.kind == RuleKind::Phong)
-            throw UsageError(fmt::format("'{}' integrates against a Phong lobe; use a lebedev, design, fibonacci or "
-                                         "mc rule",
+            throw UsageError(fmt::format("'{}' integrates against a Phong lobe; use a horizon, lebedev, design, "
+                                         "fibonacci or mc rule",
                                          rule.spec),
                              "--rule");
         const Device device = parse_flag("--device", [&] { return parse_device(o->device); });

@@ -20,6 +20,7 @@ const Family kFamilies[] = {
     {"lebedev:N, lebedev:pP", "Lebedev-Laikov rule with N points or precision P (table below)"},
     {"design:tT", "spherical T-design (1 <= T <= 40), equal weights, computed once and cached"},
     {"phong:a=A,n=N", "Phong lobe max(cos,0)^A (DPRT): 2N^2 points, precision 2N-1"},
+    {"horizon:NxM", "split at the horizon y=0 (skies): 2NM points, precision min(2N-1, M-1)"},
     {"<rule>+rotate[=SEED]", "the same rule, turned by a random rotation at every vertex"},
 };
 

@@ -26,7 +26,7 @@ namespace fs = std::filesystem;
 struct ViewModelOpts {
     AtmosphereFlags atm;
     ModelFlag model;
-    std::string input, screenshot, window_capture, screenshot_path = "skybake_view.png", size = "960x720", rule = "lebedev:2030";
+    std::string input, screenshot, window_capture, screenshot_path = "skybake_view.png", size = "960x720", rule = kSkyLightRule;
     std::vector<std::string> set;
     double elevation = 30.0, azimuth = 0.0, altitude = 0.0;
     int frames = 1;

@@ -49,9 +49,10 @@ enum class RuleKind : int {
     Lebedev = 2,    // Lebedev–Laikov, octahedral symmetry, unequal weights
     Design = 3,     // spherical t-design, equal weights
     Phong = 4,      // Gauss–Jacobi in cos θ × uniform in φ, for the Phong lobe
+    Horizon = 5,    // Gauss–Legendre in y on each side of y = 0 × uniform in φ
 };
 
-// "mc", "fibonacci", "lebedev", "design", "phong".
+// "mc", "fibonacci", "lebedev", "design", "phong", "horizon".
 const char* rule_kind_name(RuleKind kind);
 
 struct SphereRule {
@@ -92,6 +93,9 @@ double integrate(const SphereRule& rule, F&& f) {
 //   design:tT           spherical T-design, 1 ≤ T ≤ 40 (computed once, then cached)
 //   phong:a=A,n=N       Phong-lobe rule, exponent A ≥ 0, N nodes in cos θ (2N² points,
 //                       precision 2N-1)
+//   horizon:NxM         split at the horizon y = 0: N Gauss–Legendre nodes in y on
+//                       each side times M azimuths (2NM points, precision
+//                       min(2N - 1, M - 1)); for functions with a step there (skies)
 //
 // Any of them may end in "+rotate" or "+rotate=SEED": the rule is then meant to be
 // turned by a random rotation at every vertex (SphereRule::rotate_per_vertex).
@@ -102,6 +106,8 @@ struct RuleSpec {
     int precision = 0;             // lebedev: precision; design: t
     double phong_exponent = 0.0;   // phong: a
     int phong_nodes = 0;           // phong: nodes in cos θ
+    int horizon_nodes = 0;         // horizon: Gauss–Legendre nodes in y per side
+    int horizon_azimuths = 0;      // horizon: azimuths
     bool rotate = false;           // "+rotate"
     std::uint64_t rotation_seed = 0;
 
@@ -146,6 +152,15 @@ SphereRule lebedev_rule_by_points(int points);
 // hemisphere (z > 0); Σ w_k f(x_k) = ∫ f ρ_a dμ exactly for every polynomial f
 // of degree ≤ 2n − 1 (see [SECTION] Conventions). a ≥ 0 (any real), 1 ≤ n ≤ 512.
 SphereRule phong_rule(double exponent_a, int n);
+
+// A rule split at the horizon of the sky and PRT frames (+y up): n
+// Gauss–Legendre nodes in y = cos θ on (0, 1) and n on (−1, 0), each times m
+// equally spaced azimuths (φ = 2π (j + ½)/m from +x towards +z). No point lies
+// on y = 0, and each side is integrated as a rule of its own, so a function
+// with a step at the horizon (a sky over the dark ground) is integrated as
+// well as the two smooth halves are: exact for polynomials of degree
+// ≤ min(2n − 1, m − 1) on each side. 1 ≤ n ≤ 512, 1 ≤ m ≤ 4096.
+SphereRule horizon_rule(int n, int m);
 
 // [SECTION] Per-vertex random rotation -----------------------------------------------
 //

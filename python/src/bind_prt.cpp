@@ -124,7 +124,7 @@ void bind_prt(py::module_& m) {
             return sky_light(sky, s, order, rule);
         },
         py::arg("sky"), py::arg("sun_elevation_deg") = 30.0, py::arg("sun_azimuth_deg") = 0.0,
-        py::arg("altitude_km") = 0.0, py::arg("sun") = true, py::arg("order") = 3, py::arg("rule") = "lebedev:2030",
+        py::arg("altitude_km") = 0.0, py::arg("sun") = true, py::arg("order") = 3, py::arg("rule") = kSkyLightRule,
         "The sky (+y up; azimuth 0 towards +z, 90 towards +x) projected on SH, with the transmitted sun.");
     m.def(
         "constant_light",

@@ -20,7 +20,7 @@ constexpr int kMaxDesignT = 40;
 constexpr int kMaxPhongNodes = 512;
 
 const char* const kForms =
-    "expected one of mc:N[,seed=S], fibonacci:N, lebedev:N, lebedev:pP, design:tT, phong:a=A,n=N, "
+    "expected one of mc:N[,seed=S], fibonacci:N, lebedev:N, lebedev:pP, design:tT, phong:a=A,n=N, horizon:NxM, "
     "optionally followed by +rotate or +rotate=SEED";
 
 [[noreturn]] void bad(const std::string& text, const std::string& why) {
@@ -74,7 +74,7 @@ std::string lebedev_list() {
 namespace {
 constexpr NamedValue<RuleKind> kRuleKindNames[] = {
     {RuleKind::MonteCarlo, "mc"}, {RuleKind::Fibonacci, "fibonacci"}, {RuleKind::Lebedev, "lebedev"},
-    {RuleKind::Design, "design"}, {RuleKind::Phong, "phong"},
+    {RuleKind::Design, "design"}, {RuleKind::Phong, "phong"}, {RuleKind::Horizon, "horizon"},
 };
 } // namespace
 
@@ -97,6 +97,7 @@ std::string RuleSpec::canonical() const {
     }
     case RuleKind::Design: s = fmt::format("design:t{}", precision); break;
     case RuleKind::Phong: s = fmt::format("phong:a={},n={}", phong_exponent, phong_nodes); break;
+    case RuleKind::Horizon: s = fmt::format("horizon:{}x{}", horizon_nodes, horizon_azimuths); break;
     }
     if (rotate)
         s += rotation_seed == 0 ? "+rotate" : fmt::format("+rotate={}", rotation_seed);
@@ -187,6 +188,19 @@ RuleSpec parse_rule_spec(const std::string& text) {
             bad(text, "expected phong:a=A,n=N with both the exponent a and the node count n (e.g. phong:a=32,n=8)");
         return spec;
     }
+    if (family == "horizon") {
+        spec.kind = RuleKind::Horizon;
+        const std::size_t x = args.find('x');
+        long long m = 0;
+        if (x == std::string_view::npos || !parse_int(args.substr(0, x), v) || !parse_int(args.substr(x + 1), m) ||
+            v < 1 || v > kMaxPhongNodes || m < 1 || m > 4096)
+            bad(text, fmt::format("expected horizon:NxM with N (nodes in y per side) from 1 to {} and M (azimuths) "
+                                  "from 1 to 4096 (e.g. horizon:32x48)",
+                                  kMaxPhongNodes));
+        spec.horizon_nodes = int(v);
+        spec.horizon_azimuths = int(m);
+        return spec;
+    }
     bad(text, fmt::format("unknown rule family '{}'; {}", family, kForms));
 }
 
@@ -198,6 +212,7 @@ SphereRule make_rule(const RuleSpec& spec) {
     case RuleKind::Lebedev: rule = lebedev_rule_by_precision(spec.precision); break;
     case RuleKind::Design: rule = design_rule(spec.precision); break;
     case RuleKind::Phong: rule = phong_rule(spec.phong_exponent, spec.phong_nodes); break;
+    case RuleKind::Horizon: rule = horizon_rule(spec.horizon_nodes, spec.horizon_azimuths); break;
     }
     rule.spec = spec.canonical();
     rule.rotate_per_vertex = spec.rotate;
