@@ -79,6 +79,29 @@ TEST(PrtCli, BakeRelightPlyAndPng) {
     EXPECT_GT(l.sun_irradiance.x, l.sun_irradiance.z); // a low sun is red
     r = run_cli({"prt", "relight", out, "--light", light, "-o", dir + "/lit2.ply"});
     EXPECT_EQ(r.exit_code, 0) << r.err;
+    // The same light in the Condon-Shortley convention: odd-|m| coefficients
+    // negated in the file (l = 1, m = +-1: indices 1 and 3; l = 2, m = +-1: 5
+    // and 7), the others equal, and the same light once loaded.
+    const std::string cs = dir + "/light_cs.json";
+    r = run_cli({"sky", "sh", "--sun-elevation-deg", "10", "--order", "2", "--sh-convention", "condon-shortley", "-o",
+                 cs});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    {
+        const auto raw = [](const std::string& path) {
+            std::ifstream f(path);
+            return nlohmann::json::parse(f);
+        };
+        const nlohmann::json a = raw(light), b = raw(cs);
+        EXPECT_EQ(b["sh_convention"], "condon-shortley");
+        for (int i = 0; i < 9; ++i) {
+            const double sign = (i == 1 || i == 3 || i == 5 || i == 7) ? -1.0 : 1.0;
+            for (int c = 0; c < 3; ++c)
+                EXPECT_EQ(b["coefficients"][i][c].get<double>(), sign * a["coefficients"][i][c].get<double>()) << i;
+        }
+        EXPECT_EQ(skybake::load_light(cs).coeffs, l.coeffs);
+    }
+    expect_refused(run_cli({"sky", "sh", "--sh-convention", "d3dx", "-o", dir + "/bad.json"}), 2, "--sh-convention");
+    EXPECT_FALSE(fs::exists(dir + "/bad.json"));
     // The GLSL, with the order of the sidecar.
     r = run_cli({"prt", "export", out, "-o", dir + "/prt.glsl"});
     ASSERT_EQ(r.exit_code, 0) << r.err;

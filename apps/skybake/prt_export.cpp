@@ -12,7 +12,7 @@ void add_prt_export(CLI::App& group) {
     auto* sub =
         group.add_subcommand("export", "Write the GLSL relighting functions (diffuse PRT, DPRT with a network)");
     struct Opts {
-        std::string input, output, model, function = "skybake_prt";
+        std::string input, output, model, function = "skybake_prt", convention = "skybake";
         int order = 3, channels = 1, nodes = 0;
         double glossy = 0.0;
     };
@@ -31,6 +31,10 @@ void add_prt_export(CLI::App& group) {
     sub->add_option("--nodes", o->nodes, "Nodes in cos θ of the Phong rule (default: order/2 + 1)")
         ->check(integer_in(1, 64));
     sub->add_option("--name", o->function, "Function name prefix (letters, digits and _)")->capture_default_str();
+    sub->add_option("--sh-convention", o->convention,
+                    "Convention of the light[] the diffuse function takes: skybake (as `sky sh` writes by default) "
+                    "or condon-shortley ((-1)^m, Sloan 2008 and D3DX: the function negates the odd-|m| terms)")
+        ->capture_default_str();
     sub->callback([o, sub] {
         check_output_path(o->output, {".glsl", ".vert", ".frag", ".txt"}, "--output");
         if (!valid_shader_identifier(o->function))
@@ -54,6 +58,7 @@ void add_prt_export(CLI::App& group) {
         }
         PrtShaderOptions so;
         so.function_name = o->function;
+        so.light_convention = parse_flag("--sh-convention", [&] { return parse_sh_convention(o->convention); });
         NeuralSky net;
         SphereRule phong;
         if (!o->model.empty()) {

@@ -17,7 +17,7 @@ void add_sky_sh(CLI::App& group) {
     struct Opts {
         AtmosphereFlags atm;
         ModelFlag model;
-        std::string output, rule = kSkyLightRule, device = "cpu";
+        std::string output, rule = kSkyLightRule, device = "cpu", convention = "skybake";
         double elevation = 30.0, azimuth = 0.0, altitude = 0.0;
         int order = 3;
         bool json = false;
@@ -39,6 +39,10 @@ void add_sky_sh(CLI::App& group) {
         ->capture_default_str();
     sub->add_option("--rule", o->rule, "Sphere rule of the projection (see 'sphere list')")->capture_default_str();
     sub->add_option("--device", o->device, "cpu or cuda (the sky's evaluation)")->capture_default_str();
+    sub->add_option("--sh-convention", o->convention,
+                    "Signs of the written coefficients: skybake (no (-1)^m, Ramamoorthi & Hanrahan 2001) or "
+                    "condon-shortley ((-1)^m, Sloan 2008 and D3DX: odd-|m| terms negated); the file records it")
+        ->capture_default_str();
     sub->add_option("-o,--output", o->output, "Light JSON file (order, RGB coefficients, sun)")->required();
     add_json_flag(*sub, o->json);
     sub->callback([o, sub] {
@@ -50,6 +54,8 @@ void add_sky_sh(CLI::App& group) {
                                          rule.spec),
                              "--rule");
         const Device device = parse_flag("--device", [&] { return parse_device(o->device); });
+        const ShConvention convention =
+            parse_flag("--sh-convention", [&] { return parse_sh_convention(o->convention); });
         const bool neural = o->model.active();
         const SkySource sky = neural ? SkySource::network(o->model.load(*sub, o->atm), device)
                                      : SkySource::reference(SkyModel(o->atm.load(*sub)), SkyMethod::Tables, device);
@@ -61,12 +67,13 @@ void add_sky_sh(CLI::App& group) {
         const auto t0 = std::chrono::steady_clock::now();
         const ShLight light = projector.project(sky, s);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        const std::string text = light_json(light, neural ? "network" : "reference", rule.spec);
+        const std::string text = light_json(light, neural ? "network" : "reference", rule.spec, convention);
         write_stream_atomic(o->output, [&](std::ostream& out) { out << text; });
         if (o->json) {
             print_json({{"output", o->output},
                         {"order", light.order},
                         {"rule", rule.spec},
+                        {"sh_convention", sh_convention_name(convention)},
                         {"source", sky.method_name()},
                         {"seconds", seconds},
                         {"L00", {light.coeffs[0].x, light.coeffs[0].y, light.coeffs[0].z}},

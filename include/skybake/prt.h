@@ -319,6 +319,11 @@ Image render_prt_preview(const Mesh& mesh, const Transfer& transfer, std::span<c
 //       included.
 struct PrtShaderOptions {
     std::string function_name = "skybake_prt";
+    // The convention of the light[] that NAME_diffuse is given (the transfer
+    // is stored in skybake's): with CondonShortley the function flips the
+    // odd-|m| terms itself, so a light projected by D3DX-style code is used as
+    // it is.
+    ShConvention light_convention = ShConvention::Skybake;
     const SphereRule* phong = nullptr; // a Phong rule: adds NAME_glossy (needs network)
     const NeuralSky* network = nullptr;
 };
@@ -349,8 +354,14 @@ std::string transfer_sidecar_json(const Transfer& transfer, std::size_t vertices
 //   {"format": "skybake-sh-light", "version": 1, "order": 3,
 //    "coefficients": [[r, g, b], ...]  ((order + 1)² of them, sh_index order),
 //    "sun_direction": [x, y, z], "sun_irradiance": [r, g, b],
-//    "source": "reference" | "network" | ..., "rule": "lebedev:590"}
-std::string light_json(const ShLight& light, const std::string& source, const std::string& rule);
+//    "source": "reference" | "network" | ..., "rule": "lebedev:590",
+//    "sh_convention": "skybake" | "condon-shortley"}
+// The coefficients are written in `convention` (skybake/sh.h, ShConvention)
+// and the file says which; load_light() converts them back to skybake's, so
+// a file in either convention relights the same. A file without the member
+// is in skybake's.
+std::string light_json(const ShLight& light, const std::string& source, const std::string& rule,
+                       ShConvention convention = ShConvention::Skybake);
 // Throws skybake::Error (where: "light") for a missing, corrupt or inconsistent file.
 ShLight load_light(const std::filesystem::path& path);
 // The same from the file's text (what load_light() reads); `name` stands for

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 #include <vector>
 
 #include <glm/mat3x3.hpp>
@@ -29,13 +30,44 @@ namespace skybake {
 //   Y_1,-1 = √(3/4π) y,   Y_10 = √(3/4π) z,   Y_11 = √(3/4π) x
 //   Y_2,-2 = ½√(15/π) xy, Y_2,-1 = ½√(15/π) yz, Y_20 = ¼√(5/π)(3z² − 1),
 //   Y_21 = ½√(15/π) xz,   Y_22 = ¼√(15/π)(x² − y²)
-// (the table used by Ramamoorthi & Hanrahan 2001 and Sloan et al. 2002).
+// This is the table of Ramamoorthi & Hanrahan 2001 ("An efficient
+// representation for irradiance environment maps", eq. 3): every Y_lm
+// positive where its polynomial is, no (−1)^m. Sloan's "Stupid spherical
+// harmonics tricks" (2008) and D3DX (D3DXSHEvalDirection) use the
+// Condon–Shortley phase instead: their Y_lm is (−1)^m times ours, so the
+// coefficients with odd |m| (Y_1,±1, Y_2,±1, Y_3,±1, Y_3,±3, ...) change sign
+// and the others are equal. skybake computes in its own convention and
+// converts at its edges (ShConvention below: light files, shader exports).
 //
 // "lmax" is the highest band l; a band-limited function has sh_count(lmax) =
 // (lmax + 1)² coefficients, stored at sh_index(l, m) = l² + l + m. lmax ≤ 200.
 constexpr int kShMaxL = 200;
 constexpr int sh_count(int lmax) { return (lmax + 1) * (lmax + 1); }
 constexpr int sh_index(int l, int m) { return l * l + l + m; }
+
+// The sign convention of a set of coefficients outside skybake.
+enum class ShConvention : int {
+    Skybake = 0,        // the table above (Ramamoorthi & Hanrahan 2001), no (−1)^m
+    CondonShortley = 1, // (−1)^m Y_lm: Sloan 2008, D3DX
+};
+// "skybake", "condon-shortley".
+const char* sh_convention_name(ShConvention convention);
+// Throws skybake::Error (where: "sh_convention") listing the names.
+ShConvention parse_sh_convention(const std::string& text);
+// The factor between the two conventions for index sh_index(l, m): −1 for
+// odd |m| under CondonShortley, else 1. Converting is its own inverse.
+constexpr double sh_convention_sign(int m, ShConvention convention) {
+    return convention == ShConvention::CondonShortley && (m % 2 != 0) ? -1.0 : 1.0;
+}
+// Multiplies each of the sh_count(lmax) coefficients (index order) by its
+// sh_convention_sign(): skybake's coefficients into `convention`, or back.
+template <class T>
+void convert_sh_convention(std::vector<T>& coeffs, int lmax, ShConvention convention) {
+    for (int l = 0; l <= lmax; ++l)
+        for (int m = -l; m <= l; ++m)
+            if (const std::size_t i = std::size_t(sh_index(l, m)); i < coeffs.size() && sh_convention_sign(m, convention) < 0)
+                coeffs[i] = -coeffs[i];
+}
 
 // [SECTION] Evaluation -----------------------------------------------------------------
 

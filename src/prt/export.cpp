@@ -40,16 +40,26 @@ std::string export_prt_glsl(int order, int channels, const PrtShaderOptions& o) 
     std::string s = fmt::format("// skybake PRT relighting: SH order {} ({} coefficients), {} transfer.\n", order, nc,
                                 channels == 1 ? "grey" : "RGB");
     s += fmt::format("vec3 {}_diffuse(vec4 prt[{}], vec3 light[{}], vec3 albedo) {{\n", name, attrs, nc);
+    // The sign of each term: light[] in o.light_convention, the transfer in skybake's.
+    std::vector<char> sign(std::size_t(nc), '+');
+    for (int l = 0; l <= order; ++l)
+        for (int m = -l; m <= l; ++m)
+            if (sh_convention_sign(m, o.light_convention) < 0)
+                sign[std::size_t(sh_index(l, m))] = '-';
+    if (o.light_convention != ShConvention::Skybake)
+        s += fmt::format("// light[]: {} convention (odd-|m| terms enter with a minus sign).\n",
+                         sh_convention_name(o.light_convention));
     if (channels == 1) {
         s += "    vec3 b = vec3(0.0);\n";
         for (int i = 0; i < nc; ++i)
-            s += fmt::format("    b += light[{}] * prt[{}].{};\n", i, i / 4, lane[i % 4]);
+            s += fmt::format("    b {}= light[{}] * prt[{}].{};\n", sign[std::size_t(i)], i, i / 4, lane[i % 4]);
     } else {
         s += "    vec3 b = vec3(0.0);\n";
         for (int ch = 0; ch < 3; ++ch)
             for (int i = 0; i < nc; ++i) {
                 const int k = ch * nc + i;
-                s += fmt::format("    b.{} += light[{}].{} * prt[{}].{};\n", lane[ch], i, lane[ch], k / 4, lane[k % 4]);
+                s += fmt::format("    b.{} {}= light[{}].{} * prt[{}].{};\n", lane[ch], sign[std::size_t(i)], i,
+                                 lane[ch], k / 4, lane[k % 4]);
             }
     }
     s += "    return albedo * b;\n}\n";

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <random>
 
+#include <fmt/format.h>
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
@@ -247,6 +248,67 @@ TEST_F(SkyLight, BadSettings) {
     } catch (const Error& e) {
         EXPECT_EQ(e.where(), "rule");
     }
+}
+
+} // namespace
+} // namespace skybake
+
+namespace skybake {
+namespace {
+
+// Both conventions against bases written out here from their published
+// tables (l ≤ 2): Ramamoorthi & Hanrahan 2001 (skybake's, all signs +) and
+// D3DX / Sloan 2008 (Condon–Shortley: Y_1,-1 = −0.4886 y, Y_11 = −0.4886 x,
+// Y_2,-1 = −1.0925 yz, Y_21 = −1.0925 xz). A light projected with either
+// table equals skybake's projection converted to that convention, and a
+// light file in either convention loads as the same light.
+TEST(ShConvention, EachConventionMatchesItsPublishedTable) {
+    const auto basis = [](const glm::dvec3& d, bool condon_shortley) {
+        const double s = condon_shortley ? -1.0 : 1.0, x = d.x, y = d.y, z = d.z;
+        return std::vector<double>{0.282094792,         s * 0.488602512 * y,       0.488602512 * z,
+                                   s * 0.488602512 * x, 1.092548431 * x * y,       s * 1.092548431 * y * z,
+                                   0.315391565 * (3 * z * z - 1), s * 1.092548431 * x * z,
+                                   0.546274215 * (x * x - y * y)};
+    };
+    const auto f = [](const glm::dvec3& d) { // a light with every band and odd and even m
+        return glm::dvec3(1.0 + 0.7 * d.x - 0.4 * d.y * d.z + 0.9 * d.x * d.z, 0.5 + d.y * d.x + 0.3 * d.z,
+                          2.0 + 0.2 * d.x * d.x - 0.6 * d.y);
+    };
+    const SphereRule rule = parse_rule("lebedev:590");
+    const ShLight ours = project_light([&](const glm::vec3& d) { return glm::vec3(f(glm::dvec3(d))); }, 2, rule);
+    for (const ShConvention convention : {ShConvention::Skybake, ShConvention::CondonShortley}) {
+        std::vector<glm::dvec3> table(9, glm::dvec3(0.0));
+        for (std::size_t k = 0; k < rule.size(); ++k) {
+            const std::vector<double> y = basis(rule.points[k], convention == ShConvention::CondonShortley);
+            for (int i = 0; i < 9; ++i)
+                table[std::size_t(i)] += 4.0 * M_PI * rule.weights[k] * y[std::size_t(i)] * f(rule.points[k]);
+        }
+        std::vector<glm::vec3> converted = ours.coeffs;
+        convert_sh_convention(converted, 2, convention);
+        for (int i = 0; i < 9; ++i)
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(converted[std::size_t(i)][c], table[std::size_t(i)][c], 2e-5)
+                    << sh_convention_name(convention) << " coefficient " << i << " channel " << c;
+        // Written in this convention, read back in skybake's.
+        const ShLight back = light_from_json(light_json(ours, "test", rule.spec, convention), "light.json");
+        for (int i = 0; i < 9; ++i)
+            EXPECT_EQ(back.coeffs[std::size_t(i)], ours.coeffs[std::size_t(i)]) << i;
+    }
+    EXPECT_EQ(parse_sh_convention("condon-shortley"), ShConvention::CondonShortley);
+    EXPECT_THROW(parse_sh_convention("d3dx"), Error);
+}
+
+// The exported diffuse function takes a Condon–Shortley light by negating the
+// odd-|m| terms: 1 (l=1, m=-1), 3 (l=1, m=1), 5 and 7 (l=2, m=±1).
+TEST(ShConvention, ExportedDiffuseNegatesOddMTerms) {
+    PrtShaderOptions o;
+    o.light_convention = ShConvention::CondonShortley;
+    const std::string glsl = export_prt_glsl(2, 1, o);
+    for (const int i : {1, 3, 5, 7})
+        EXPECT_NE(glsl.find(fmt::format("b -= light[{}] *", i)), std::string::npos) << i << "\n" << glsl;
+    for (const int i : {0, 2, 4, 6, 8})
+        EXPECT_NE(glsl.find(fmt::format("b += light[{}] *", i)), std::string::npos) << i;
+    EXPECT_EQ(export_prt_glsl(2, 1).find("b -="), std::string::npos);
 }
 
 } // namespace

@@ -168,9 +168,12 @@ std::string transfer_sidecar_json(const Transfer& t, std::size_t vertices, const
     return j.dump(2) + "\n";
 }
 
-std::string light_json(const ShLight& light, const std::string& source, const std::string& rule) {
+std::string light_json(const ShLight& light, const std::string& source, const std::string& rule,
+                       ShConvention convention) {
+    std::vector<glm::vec3> coeffs = light.coeffs;
+    convert_sh_convention(coeffs, light.order, convention);
     nlohmann::json c = nlohmann::json::array();
-    for (const glm::vec3& v : light.coeffs)
+    for (const glm::vec3& v : coeffs)
         c.push_back({v.x, v.y, v.z});
     const glm::vec3 d = light.sun_direction, e = light.sun_irradiance;
     nlohmann::json j = {{"format", "skybake-sh-light"},
@@ -180,7 +183,8 @@ std::string light_json(const ShLight& light, const std::string& source, const st
                         {"sun_direction", {d.x, d.y, d.z}},
                         {"sun_irradiance", {e.x, e.y, e.z}},
                         {"source", source},
-                        {"rule", rule}};
+                        {"rule", rule},
+                        {"sh_convention", sh_convention_name(convention)}};
     return j.dump(1) + "\n";
 }
 
@@ -209,6 +213,11 @@ ShLight light_from_json(std::string_view text, const std::string& name) {
         };
         for (const auto& v : c)
             l.coeffs.push_back(vec(v));
+        if (j.contains("sh_convention")) {
+            if (!j["sh_convention"].is_string())
+                throw Error(fmt::format("{}: sh_convention is not a string", name), "light");
+            convert_sh_convention(l.coeffs, l.order, parse_sh_convention(j["sh_convention"].get<std::string>()));
+        }
         // The sun: a direction (any length but zero) and an
         // irradiance ≥ 0 per channel (zero: no sun).
         const glm::vec3 d = vec(j.at("sun_direction"));

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "skybake/error.h"
+#include "skybake/names.h"
 #include "skybake/sh.h"
 #include "sphere/sh_eval.h"
 
@@ -173,6 +174,19 @@ std::vector<double> sh_convolve_zonal(const std::vector<double>& coeffs, int lma
         for (int m = -l; m <= l; ++m)
             out[std::size_t(sh_index(l, m))] = kernel[std::size_t(l)] * coeffs[std::size_t(sh_index(l, m))];
     return out;
+}
+
+namespace {
+constexpr NamedValue<ShConvention> kShConventionNames[] = {
+    {ShConvention::Skybake, "skybake", "no (-1)^m: Ramamoorthi & Hanrahan 2001"},
+    {ShConvention::CondonShortley, "condon-shortley", "(-1)^m: Sloan 2008, D3DX"},
+};
+} // namespace
+
+const char* sh_convention_name(ShConvention convention) { return name_of(kShConventionNames, convention); }
+
+ShConvention parse_sh_convention(const std::string& text) {
+    return parse_name(kShConventionNames, text, "SH convention", "sh_convention");
 }
 
 } // namespace skybake
