@@ -7,10 +7,14 @@ namespace skybake::cli {
 Mesh load_model(const std::string& path) {
     ImportReport report;
     Mesh mesh = load_mesh(path, &report);
+    warn_missing_textures(path, report);
+    return mesh;
+}
+
+void warn_missing_textures(const std::string& path, const ImportReport& report) {
     for (const std::string& t : report.missing_textures)
         info("warning: {}: texture '{}' not found (looked beside the model too); its material keeps its colour",
              path, t);
-    return mesh;
 }
 
 void parse_size(const std::string& text, int& width, int& height, const char* flag) {

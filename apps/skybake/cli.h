@@ -37,6 +37,8 @@ void info(fmt::format_string<Args...> f, Args&&... args) {
 // load_mesh(), with a warning line for each texture the model names that was
 // not found (the material keeps its colour): every command that reads a model.
 Mesh load_model(const std::string& path);
+// The warning lines of load_model(), for a report from elsewhere.
+void warn_missing_textures(const std::string& path, const ImportReport& report);
 
 // Parses "WxH" (e.g. "1280x720"); throws skybake::Error naming the flag.
 void parse_size(const std::string& text, int& width, int& height, const char* flag);

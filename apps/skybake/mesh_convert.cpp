@@ -31,9 +31,7 @@ void run(const MeshConvertOptions& o) {
             throw UsageError("a .gltf output keeps a glTF 2.0 input's document; write other inputs as .glb",
                              "--output");
         mesh = load_mesh(o.input, &rep);
-        for (const std::string& t : rep.missing_textures)
-            info("warning: {}: texture '{}' not found (looked beside the model too); its material keeps its colour",
-                 o.input, t);
+        warn_missing_textures(o.input, rep);
         ExportOptions e;
         e.ply_encoding = o.ascii ? PlyEncoding::Ascii : PlyEncoding::Binary;
         save_mesh(o.output, mesh, e);
