@@ -622,9 +622,12 @@ void write_glb(const std::filesystem::path& tmp, const Mesh& mesh) {
         std::error_code ec;
         if ((ext == ".png" || ext == ".jpg" || ext == ".jpeg") &&
             std::filesystem::is_regular_file(m.base_color_texture, ec)) {
+            // Materials sharing a file: read it once.
+            if (auto it = texture_of.find("file:" + m.base_color_texture); it != texture_of.end())
+                return it->second;
             const std::string data = read_file(m.base_color_texture);
-            return embedded(std::vector<unsigned char>(data.begin(), data.end()),
-                            ext == ".png" ? "image/png" : "image/jpeg");
+            return texture_of["file:" + m.base_color_texture] = embedded(
+                       std::vector<unsigned char>(data.begin(), data.end()), ext == ".png" ? "image/png" : "image/jpeg");
         }
         return referenced(m.base_color_texture);
     };
