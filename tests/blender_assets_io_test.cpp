@@ -6,12 +6,18 @@
 // Blender's exports are the common case the sample models miss: untextured
 // materials (no "images", "textures" or "samplers" arrays), or no material at
 // all (no "materials" array), with Smart UV Project's islands.
+#include <algorithm>
+#include <array>
 #include <cctype>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <map>
+#include <numeric>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -21,6 +27,8 @@
 #include "cli_runner.h"
 #include "skybake/files.h"
 #include "skybake/image.h"
+#include "skybake/mesh.h"
+#include "skybake/texture_bake.h"
 
 using skybake::test::run_cli;
 namespace fs = std::filesystem;
@@ -163,3 +171,76 @@ INSTANTIATE_TEST_SUITE_P(, BlenderAssets,
                                      ch = '_';
                              return name;
                          });
+
+// Smart UV Project cuts Suzanne into islands: the two (or more) vertices that
+// Blender writes for one point on a cut read the baked texture alike once the
+// seams are stitched. Pairs are counted where they share a 3D edge (a seam);
+// Suzanne's eyes touch her head at points that are not on one surface, and
+// their AO differs truly. Measured at 512², lebedev:86: 0.089 mean, 0.35 at the
+// 95th percentile, 0.88 at most as traced; 3e-4 mean, 3e-4 at the 95th
+// percentile, 0.027 at most stitched.
+TEST(BlenderSeams, SplitVerticesOfSmartUvIslandsReadTheSameAo) {
+    if (blender().empty())
+        GTEST_SKIP() << "no blender (scripts/install-deps.sh installs it)";
+    const fs::path dir = skybake::test::temp_dir("blender-assets-seams");
+    const fs::path in = dir / "plain.glb";
+    std::string why;
+    ASSERT_TRUE(make_suzanne(in, "bare", why)) << why;
+    auto stats = [&](bool keep) {
+        const fs::path out = dir / (keep ? "kept.glb" : "stitched.glb");
+        const fs::path exr = dir / (keep ? "kept.exr" : "stitched.exr");
+        std::vector<std::string> args = {"ao",        in.string(), "-o",       out.string(), "--texture",
+                                         "512",       "--rule",    "lebedev:86", "--texture-out", exr.string()};
+        if (keep)
+            args.push_back("--keep-seams");
+        const auto r = run_cli(args, 300);
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        const skybake::Mesh mesh = skybake::load_mesh(out);
+        const skybake::Image image = skybake::load_image(exr);
+        skybake::AoTexture t;
+        t.texture_size = image.width;
+        for (int k = 0; k < image.width * image.height; ++k)
+            t.ao.push_back(image.rgb[3 * std::size_t(k)]);
+        // Weld by position; a vertex's neighbours are welded points.
+        std::map<std::array<float, 3>, std::uint32_t> ids;
+        std::vector<std::uint32_t> weld(mesh.vertex_count());
+        for (std::size_t v = 0; v < weld.size(); ++v) {
+            const auto& p = mesh.positions[v];
+            weld[v] = ids.emplace(std::array<float, 3>{p.x, p.y, p.z}, std::uint32_t(ids.size())).first->second;
+        }
+        std::vector<std::set<std::uint32_t>> neighbours(mesh.vertex_count());
+        std::vector<std::vector<std::size_t>> at(ids.size());
+        for (std::size_t v = 0; v < weld.size(); ++v)
+            at[weld[v]].push_back(v);
+        for (std::size_t i = 0; i < mesh.indices.size(); ++i) {
+            const std::size_t tri = i / 3 * 3;
+            const std::uint32_t a = mesh.indices[i], b = mesh.indices[tri + (i - tri + 1) % 3];
+            neighbours[a].insert(weld[b]);
+            neighbours[b].insert(weld[a]);
+        }
+        const auto& uv = mesh.texcoords.at(0);
+        std::vector<double> d;
+        for (const auto& vs : at)
+            for (std::size_t i = 0; i < vs.size(); ++i)
+                for (std::size_t j = i + 1; j < vs.size(); ++j) {
+                    const std::size_t a = vs[i], b = vs[j];
+                    if (uv[a] == uv[b])
+                        continue;
+                    std::vector<std::uint32_t> common;
+                    std::set_intersection(neighbours[a].begin(), neighbours[a].end(), neighbours[b].begin(),
+                                          neighbours[b].end(), std::back_inserter(common));
+                    if (!common.empty())
+                        d.push_back(std::abs(skybake::sample_texture(t, uv[a]) - skybake::sample_texture(t, uv[b])));
+                }
+        EXPECT_GT(d.size(), 500u);
+        std::sort(d.begin(), d.end());
+        const double mean = std::accumulate(d.begin(), d.end(), 0.0) / double(std::max<std::size_t>(d.size(), 1));
+        const double p95 = d.empty() ? 0.0 : d[d.size() * 95 / 100];
+        return std::array<double, 3>{mean, p95, d.empty() ? 0.0 : d.back()};
+    };
+    const auto kept = stats(true), stitched = stats(false);
+    EXPECT_GT(kept[0], 0.03) << "the layout has no visible seams to stitch";
+    EXPECT_LT(stitched[0], 0.002);
+    EXPECT_LT(stitched[1], 0.005);
+    EXPECT_LT(stitched[2], 0.06);
+}

@@ -35,6 +35,22 @@ bool has_child(pid_t pid) {
     return bool(children >> first);
 }
 
+// Whether process `pid` runs the CLI and has installed its handler for `sig`
+// (/proc/PID/status, SigCgt). A fixed delay is not enough on a loaded
+// machine: a signal sent before the handlers exist kills the process.
+bool catches(pid_t pid, int sig) {
+    std::error_code ec;
+    const auto exe = std::filesystem::read_symlink("/proc/" + std::to_string(pid) + "/exe", ec);
+    if (ec || exe != std::filesystem::path(SKYBAKE_CLI_PATH).lexically_normal())
+        return false;
+    std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+    std::string line;
+    while (std::getline(status, line))
+        if (line.rfind("SigCgt:", 0) == 0)
+            return (std::stoull(line.substr(7), nullptr, 16) >> (sig - 1)) & 1u;
+    return false;
+}
+
 CliResult run(const std::vector<std::string>& args, int timeout_s, double signal_after_s, int sig, bool after_fork) {
     namespace fs = std::filesystem;
     static int counter = 0;
@@ -61,6 +77,8 @@ CliResult run(const std::vector<std::string>& args, int timeout_s, double signal
     }
     int status = 0;
     if (signal_after_s > 0.0) {
+        for (int i = 0; i < 6000 && !catches(pid, sig); ++i)
+            usleep(10000); // up to a minute for the CLI to install its handlers
         for (int i = 0; after_fork && i < 6000 && !has_child(pid); ++i)
             usleep(10000); // up to a minute for the CLI to start its parser
         usleep(useconds_t(signal_after_s * 1e6));
