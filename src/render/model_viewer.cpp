@@ -16,6 +16,7 @@
 #include <csignal>
 #include <filesystem>
 #include <future>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,12 @@ bool viewer_window_available() {
 }
 
 namespace {
+
+// The skies that the panel's atmosphere or weights choice builds off the window thread.
+struct SkySwitch {
+    std::unique_ptr<SkySource> network; // none for a preset
+    std::unique_ptr<SkySource> reference;
+};
 
 // A bake on a worker thread, reporting through the progress callback, which
 // throws skybake::Interrupted once Cancel was pressed.
@@ -108,6 +115,8 @@ void run_model_viewer(const ViewerModel& start_model, const ModelViewerOptions& 
     const std::vector<std::string> presets = atmosphere_preset_names();
     std::string preset_label = "(command line)";
     char weights_path[512] = "";
+    std::future<SkySwitch> pending_sky; // the skies being built for the panel's choice
+    std::string pending_label;
     std::unique_ptr<BakeJob> bake;
     std::string bake_message;
     std::string message;
@@ -155,49 +164,56 @@ void run_model_viewer(const ViewerModel& start_model, const ModelViewerOptions& 
         } else {
             ImGui::Text("sky: %s", use_network ? "network" : "reference");
         }
-        // Another atmosphere: a preset (the reference sky, its tables built now) or a weights file.
-        if (ImGui::BeginCombo("atmosphere", preset_label.c_str())) {
+        // Another atmosphere: a preset or a weights file. Its tables are built
+        // on a worker thread while the window keeps drawing the current sky;
+        // the new one replaces it at the first frame after they are ready.
+        const bool switching = pending_sky.valid();
+        if (switching) {
+            ImGui::Text("building the tables of %s ...", pending_label.c_str());
+        } else if (ImGui::BeginCombo("atmosphere", preset_label.c_str())) {
             for (const std::string& name : presets)
                 if (ImGui::Selectable(name.c_str(), name == preset_label)) {
-                    std::unique_ptr<SkySource> sky;
-                    try {
-                        sky = std::make_unique<SkySource>(SkySource::reference(SkyModel(atmosphere_preset(name))));
-                    } catch (const Error& e) {
-                        message = e.what();
-                    }
-                    if (sky) {
-                        renderer.reset(); // it points at the sky it replaces
-                        own_reference = std::move(sky);
-                        reference = own_reference.get();
-                        use_network = false;
-                        preset_label = name;
-                        rebuild();
-                        message.clear();
-                    }
+                    pending_label = name;
+                    pending_sky = std::async(std::launch::async, [name] {
+                        SkySwitch next;
+                        next.reference =
+                            std::make_unique<SkySource>(SkySource::reference(SkyModel(atmosphere_preset(name))));
+                        return next;
+                    });
                 }
             ImGui::EndCombo();
         }
         ImGui::InputText("weights", weights_path, sizeof weights_path);
         ImGui::SameLine();
-        if (ImGui::Button("load")) {
-            std::unique_ptr<SkySource> net_sky, ref_sky;
+        if (ImGui::Button("load") && !switching) {
+            pending_label = std::filesystem::path(weights_path).filename().string();
+            pending_sky = std::async(std::launch::async, [path = std::string(weights_path)] {
+                SkySwitch next;
+                NeuralSky net = load_neural_sky(path);
+                next.reference = std::make_unique<SkySource>(SkySource::reference(neural_reference_model(net)));
+                next.network = std::make_unique<SkySource>(SkySource::network(std::move(net)));
+                return next;
+            });
+        }
+        if (pending_sky.valid() &&
+            pending_sky.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
             try {
-                NeuralSky net = load_neural_sky(weights_path);
-                ref_sky = std::make_unique<SkySource>(SkySource::reference(neural_reference_model(net)));
-                net_sky = std::make_unique<SkySource>(SkySource::network(std::move(net)));
-            } catch (const Error& e) {
-                message = e.what();
-            }
-            if (net_sky) {
+                SkySwitch next = pending_sky.get();
                 renderer.reset(); // it points at the skies it replaces
-                own_network = std::move(net_sky);
-                own_reference = std::move(ref_sky);
-                network = own_network.get();
+                // A weights file brings its network and shows it; a preset
+                // has only the reference sky, and shows that.
+                use_network = next.network != nullptr;
+                if (next.network) {
+                    own_network = std::move(next.network);
+                    network = own_network.get();
+                }
+                own_reference = std::move(next.reference);
                 reference = own_reference.get();
-                use_network = true;
-                preset_label = std::filesystem::path(weights_path).filename().string();
+                preset_label = pending_label;
                 rebuild();
                 message.clear();
+            } catch (const Error& e) {
+                message = e.what();
             }
         }
         ImGui::Checkbox("sky background", &st.sky_background);

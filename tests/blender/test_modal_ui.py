@@ -25,7 +25,7 @@ args = ap.parse_args(argv)
 os.environ["SKYBAKE_PYTHONPATH"] = os.path.abspath(args.module_path)
 sys.path.insert(0, os.path.join(REPO, "integrations", "blender"))
 import skybake_bake  # noqa: E402
-from skybake_bake import bake_op, mesh_convert, module_loader  # noqa: E402
+from skybake_bake import bake_op, job, mesh_convert, module_loader  # noqa: E402
 
 skybake_bake.register()
 bpy.context.preferences.view.show_splash = False
@@ -82,15 +82,15 @@ def start_long_bake():
     with override():
         result = bpy.ops.skybake.bake_ao("INVOKE_DEFAULT", rule="lebedev:5810", backend="embree")
     check(result == {"RUNNING_MODAL"}, f"invoke() starts a modal bake ({result})")
-    check(bake_op._running is not None, "a bake job is running in a thread")
+    check(job.running is not None, "a bake job is running in a thread")
     state["t0"] = time.perf_counter()
     bpy.app.timers.register(press_escape, first_interval=1.5)
 
 
 def press_escape():
-    job = bake_op._running
-    check(job is not None and not job.done.is_set(), "the bake is still running after 1.5 s (Blender stays responsive)")
-    state["fraction_before_esc"] = job.fraction if job else None
+    bake = job.running
+    check(bake is not None and not bake.done.is_set(), "the bake is still running after 1.5 s (Blender stays responsive)")
+    state["fraction_before_esc"] = bake.fraction if bake else None
     win = window()
     win.event_simulate(type="MOUSEMOVE", value="NOTHING", x=400, y=400)
     win.event_simulate(type="ESC", value="PRESS")
@@ -100,7 +100,7 @@ def press_escape():
 
 
 def wait_cancelled():
-    if bake_op._running is not None:
+    if job.running is not None:
         if time.perf_counter() - state["esc"] > 30.0:
             check(False, "Esc ends the bake within 30 s")
             finish()
@@ -126,7 +126,7 @@ def start_short_bake():
 
 
 def wait_done():
-    if bake_op._running is not None:
+    if job.running is not None:
         if time.perf_counter() - state["t1"] > 60.0:
             check(False, "the second bake ends within 60 s")
             finish()
@@ -144,6 +144,33 @@ def wait_done():
     obj = bpy.data.objects.get("bowl")
     check(obj is None or not [a for a in obj.data.attributes if a.name.startswith("skybake_")],
           "undo removes the modal bake's attributes")
+    bpy.app.timers.register(start_sky, first_interval=0.2)
+
+
+def start_sky():
+    """The Sky World button at a width that takes seconds: a thread too, so Blender keeps drawing."""
+    with override():
+        result = bpy.ops.skybake.sky_world("INVOKE_DEFAULT", width=4096, sun_elevation_deg=12.0)
+    check(result == {"RUNNING_MODAL"}, f"Sky World at 4096 wide starts a modal job ({result})")
+    state["t2"] = time.perf_counter()
+    state["ticks"] = 0
+    bpy.app.timers.register(wait_sky, first_interval=0.1)
+
+
+def wait_sky():
+    if job.running is not None:
+        state["ticks"] += 1  # the main thread runs while the sky renders
+        if time.perf_counter() - state["t2"] > 120.0:
+            check(False, "Sky World at 4096 wide ends within 120 s")
+            finish()
+        return 0.1
+    seconds = time.perf_counter() - state["t2"]
+    world = bpy.context.scene.world
+    image = bpy.data.images.get("skybake_sky")
+    check(world is not None and world.get("skybake_sun_elevation_deg") == 12.0, "the world was set")
+    check(image is not None and tuple(image.size) == (4096, 2048), f"the panorama is 4096x2048 "
+          f"({tuple(image.size) if image else None})")
+    check(state["ticks"] >= 3, f"Blender ran {state['ticks']} timer ticks during the {seconds:.1f} s render")
     finish()
 
 

@@ -17,13 +17,13 @@ bl_info = {
 if "bpy" in locals():  # F8 / script reload: pick up edited sub-modules
     import importlib
 
-    for _name in ("module_loader", "mesh_convert", "preferences", "properties", "bake_op", "sky_op", "panel"):
+    for _name in ("module_loader", "job", "mesh_convert", "preferences", "properties", "bake_op", "sky_op", "panel"):
         if _name in locals():
             importlib.reload(locals()[_name])
 
 import bpy  # noqa: E402
 
-from . import bake_op, module_loader, mesh_convert, panel, preferences, properties, sky_op  # noqa: E402,F401
+from . import bake_op, job, module_loader, mesh_convert, panel, preferences, properties, sky_op  # noqa: E402,F401
 
 _classes = (
     preferences.SkybakePreferences,
@@ -42,7 +42,7 @@ def register():
 
 
 def unregister():
-    bake_op.cancel_running_bake()
+    job.cancel_running()
     del bpy.types.Scene.skybake
     for cls in reversed(_classes):
         bpy.utils.unregister_class(cls)

@@ -9,70 +9,19 @@ blocks. Either way the results are written on the main thread only, in
 one undo step.
 """
 
-import threading
-import time
-
 import bpy
 
-from . import mesh_convert, module_loader, properties
+from . import job, mesh_convert, module_loader, properties
 
-_running = None  # the BakeJob of a modal bake in flight (one at a time)
-
-
-class BakeCancelled(Exception):
-    """Raised by the progress callback to stop a bake (Esc)."""
+_error_text = job.error_text
 
 
-class BakeJob:
+class BakeJob(job.Job):
     """One skybake.bake_ao call, runnable in a thread, that a flag cancels."""
 
     def __init__(self, sb, mesh, options):
         self.sb, self.mesh, self.options = sb, mesh, options
-        self.fraction = 0.0
-        self.cancel_requested = False
-        self.cancelled = False
-        self.result = None
-        self.error = None
-        self.done = threading.Event()
-        self.thread = None
-        self.wall_seconds = 0.0
-
-    def _progress(self, event):  # a skybake worker thread, holding the GIL: no bpy here
-        self.fraction = event.fraction
-        if self.cancel_requested:
-            raise BakeCancelled()
-
-    def run(self):
-        start = time.perf_counter()
-        try:
-            self.result = self.sb.bake_ao(self.mesh, progress=self._progress, **self.options)
-        except (BakeCancelled, KeyboardInterrupt):
-            self.cancelled = True
-        except Exception as e:  # skybake.Error and anything unexpected: reported, never raised in Blender
-            self.error = e
-        finally:
-            self.wall_seconds = time.perf_counter() - start
-            self.done.set()
-
-    def start(self):
-        self.thread = threading.Thread(target=self.run, name="skybake bake", daemon=True)
-        self.thread.start()
-
-    def cancel(self, wait_seconds=None):
-        self.cancel_requested = True
-        if self.thread is not None and wait_seconds is not None:
-            self.thread.join(wait_seconds)
-
-
-def cancel_running_bake():
-    global _running
-    if _running is not None:
-        _running.cancel(wait_seconds=30.0)
-        _running = None
-
-
-def _error_text(e):
-    return getattr(e, "message", None) or str(e) or type(e).__name__
+        super().__init__(lambda progress: sb.bake_ao(mesh, progress=progress, **options))
 
 
 def show_in_viewport(context):
@@ -94,7 +43,7 @@ def show_in_viewport(context):
             area.tag_redraw()
 
 
-class SKYBAKE_OT_bake_ao(bpy.types.Operator):
+class SKYBAKE_OT_bake_ao(job.ModalJob, bpy.types.Operator):
     """Bake ambient occlusion, shading coefficient and bent normals of the selected meshes into attributes
     (the selected objects occlude each other)"""
 
@@ -116,8 +65,8 @@ class SKYBAKE_OT_bake_ao(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        if _running is not None:
-            cls.poll_message_set("a skybake bake is running (Esc cancels it)")
+        if job.running is not None:
+            cls.poll_message_set("a skybake job is running (Esc cancels it)")
             return False
         if context.mode != "OBJECT":
             cls.poll_message_set("switch to Object Mode to bake")
@@ -143,7 +92,7 @@ class SKYBAKE_OT_bake_ao(bpy.types.Operator):
         }
 
     def _prepare(self, context):
-        """(job, scene, objects) or None after reporting why."""
+        """(bake job, scene, objects) or None after reporting why."""
         sb = module_loader.get()
         if sb is None:
             self.report({"ERROR"}, module_loader.problem())
@@ -163,14 +112,14 @@ class SKYBAKE_OT_bake_ao(bpy.types.Operator):
             return None
         return BakeJob(sb, mesh, self._options(context)), scene, [o.name for o in objects]
 
-    def _finish(self, context, job, scene, names):
-        if job.cancelled:
+    def _finish(self, context, bake, scene, names):
+        if bake.cancelled:
             self.report({"WARNING"}, "skybake: bake cancelled, nothing written")
             return {"CANCELLED"}
-        if job.error is not None:
-            self.report({"ERROR"}, f"skybake: {_error_text(job.error)}")
+        if bake.error is not None:
+            self.report({"ERROR"}, f"skybake: {_error_text(bake.error)}")
             return {"CANCELLED"}
-        r = job.result
+        r = bake.result
         written, fallbacks, separated = [], [], []
         seen_meshes = set()
         for name, part in zip(names, scene.parts):
@@ -206,61 +155,23 @@ class SKYBAKE_OT_bake_ao(bpy.types.Operator):
         prepared = self._prepare(context)
         if prepared is None:
             return {"CANCELLED"}
-        job, scene, names = prepared
-        job.run()
-        return self._finish(context, job, scene, names)
+        bake, scene, names = prepared
+        bake.run()
+        return self._finish(context, bake, scene, names)
 
     # -- modal (UI): a thread, a timer, Esc ---------------------------------------------------
 
     def invoke(self, context, event):
-        global _running
         if bpy.app.background or context.window is None:
             return self.execute(context)
         prepared = self._prepare(context)
         if prepared is None:
             return {"CANCELLED"}
-        self._job, self._scene, self._names = prepared
-        _running = self._job
-        self._job.start()
-        wm = context.window_manager
-        self._timer = wm.event_timer_add(0.1, window=context.window)
-        wm.progress_begin(0, 100)
-        self._status(context)
-        wm.modal_handler_add(self)
-        return {"RUNNING_MODAL"}
+        bake, self._scene, self._names = prepared
+        return self._start_modal(context, bake)
 
-    def _status(self, context):
-        job = self._job
-        text = "skybake: cancelling..." if job.cancel_requested else (
-            f"skybake: baking AO {100.0 * job.fraction:.0f}% ({self._scene.vertex_count} vertices), Esc to cancel")
-        if context.workspace is not None:
-            context.workspace.status_text_set(text)
-        context.window_manager.progress_update(int(100.0 * job.fraction))
+    def _describe(self):
+        return f"baking AO ({self._scene.vertex_count} vertices)"
 
-    def _end(self, context):
-        global _running
-        wm = context.window_manager
-        if self._timer is not None:
-            wm.event_timer_remove(self._timer)
-            self._timer = None
-        wm.progress_end()
-        if context.workspace is not None:
-            context.workspace.status_text_set(None)
-        _running = None
-
-    def modal(self, context, event):
-        if event.type == "ESC" and event.value == "PRESS":
-            self._job.cancel()
-            self._status(context)
-            return {"RUNNING_MODAL"}
-        if event.type == "TIMER":
-            if self._job.done.is_set():
-                self._job.thread.join()
-                self._end(context)
-                return self._finish(context, self._job, self._scene, self._names)
-            self._status(context)
-        return {"PASS_THROUGH"}
-
-    def cancel(self, context):  # Blender closes the window or reloads the file mid-bake
-        self._job.cancel(wait_seconds=30.0)
-        self._end(context)
+    def _done(self, context):
+        return self._finish(context, self._job, self._scene, self._names)

@@ -2,7 +2,7 @@
 
 import bpy
 
-from . import bake_op, mesh_convert, module_loader
+from . import job, mesh_convert, module_loader
 
 
 class SKYBAKE_PT_bake(bpy.types.Panel):
@@ -32,8 +32,8 @@ class SKYBAKE_PT_bake(bpy.types.Panel):
         meshes = [o for o in context.selected_objects if o.type == "MESH"]
         row = layout.row()
         row.scale_y = 1.4
-        if bake_op._running is not None:
-            row.label(text=f"Baking {100.0 * bake_op._running.fraction:.0f}%, Esc cancels", icon="TIME")
+        if job.running is not None:
+            row.label(text=f"skybake is busy: {100.0 * job.running.fraction:.0f}%, Esc cancels", icon="TIME")
         else:
             row.operator("skybake.bake_ao", icon="RENDER_STILL",
                          text=f"Bake {len(meshes)} object{'s' if len(meshes) != 1 else ''}")
