@@ -19,6 +19,7 @@
 // with the sky background and without it), ≥ 30 dB. The backgrounds differ
 // by design (the network per pixel against relight's SH light).
 #include <algorithm>
+#include <cstdint>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -416,6 +417,42 @@ TEST(ViewCliModels, MeshWithoutNormalsGetsThem) {
     EXPECT_NE(r.err.find("normals computed"), std::string::npos) << r.err;
     const Image img = load_image(out);
     EXPECT_GT(luminance_stddev(img), 0.0); // the model shows against the background
+}
+
+// Base colour images are sampled per pixel: a flat quad (one normal, so
+// uniform light) whose 8×8 image is white on its left half and 0.25 (linear)
+// on its right shows both, 4:1. Sampled per vertex, the four corners read the
+// same blend of both halves and the quad would be one colour.
+TEST(ViewCliModels, BaseColourImagesAreSampledPerPixel) {
+    const std::string dir = test::temp_dir("view_texture");
+    std::vector<std::uint8_t> px(8 * 8 * 3);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x)
+            for (int c = 0; c < 3; ++c)
+                px[std::size_t((y * 8 + x) * 3 + c)] = x < 4 ? 255 : 137; // sRGB 137: 0.2502 linear
+    save_png_srgb8(dir + "/halves.png", 8, 8, px.data());
+    std::ofstream(dir + "/quad.mtl") << "newmtl halves\nKd 1 1 1\nmap_Kd halves.png\n";
+    std::ofstream(dir + "/quad.obj") << "mtllib quad.mtl\nv -1 0 -1\nv 1 0 -1\nv 1 0 1\nv -1 0 1\n"
+                                        "vt 0 1\nvt 1 1\nvt 1 0\nvt 0 0\nvn 0 1 0\nusemtl halves\n"
+                                        "f 1/1/1 4/4/1 3/3/1\nf 1/1/1 3/3/1 2/2/1\n";
+    const std::string out = dir + "/quad.exr";
+    const auto r = run_cli({"view", dir + "/quad.obj", "--screenshot", out, "--size", "160x120", "--set",
+                            "exposure=0", "--set", "background=none", "--set", "samples=1", "--set", "shadow=none",
+                            "--set", "view=30,60"},
+                           300);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const Image img = load_image(out);
+    std::vector<double> lum;
+    for (int y = 0; y < img.height; ++y)
+        for (int x = 0; x < img.width; ++x) {
+            const float* p = img.pixel(x, y);
+            if (!(p[0] == 0.035f && p[1] == 0.045f && p[2] == 0.065f))
+                lum.push_back(0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]);
+        }
+    ASSERT_GT(lum.size(), std::size_t(img.width * img.height / 10));
+    std::sort(lum.begin(), lum.end());
+    const double dark = lum[lum.size() / 10], bright = lum[lum.size() * 9 / 10];
+    EXPECT_NEAR(dark / bright, 0.2502, 0.01) << "dark " << dark << ", bright " << bright;
 }
 
 TEST(ViewCliModels, FramesAreCountedAndTheLastWritten) {

@@ -169,8 +169,19 @@ TransferReport bake_transfer(Mesh& mesh, const SphereRule& rule, VisibilityTrace
 // vertex's UV, repeating; skipped when the file does not load) × the vertex
 // colour (RGB), clamped to [0, 1]. A vertex without a material: its colour, or
 // `fallback` when the mesh has no colours. A vertex of several parts takes the
-// material of the first triangle that uses it.
-std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const glm::vec3& fallback = glm::vec3(0.8f));
+// material of the first triangle that uses it. With `images` false the base
+// colour images are left out (a renderer that samples them per pixel
+// multiplies them in itself).
+std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const glm::vec3& fallback = glm::vec3(0.8f),
+                                   bool images = true);
+
+// Each material's base colour image, decoded (linear RGB), in the order of
+// Mesh::materials; an empty Image where a material has none or its file does
+// not load.
+std::vector<Image> base_color_images(const Mesh& mesh);
+
+// Each vertex's material (that of the first triangle using it), or -1.
+std::vector<int> vertex_materials(const Mesh& mesh);
 
 // [SECTION] Light ----------------------------------------------------------------------------
 

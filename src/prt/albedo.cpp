@@ -34,18 +34,10 @@ glm::vec3 sample_bilinear(const Image& img, glm::vec2 uv) {
 
 } // namespace
 
-std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const glm::vec3& fallback) {
-    const std::size_t n = mesh.vertex_count();
-    const bool colors = mesh.colors.size() == n;
-    std::vector<glm::vec3> albedo(n, fallback);
-    if (colors)
-        for (std::size_t v = 0; v < n; ++v)
-            albedo[v] = glm::vec3(mesh.colors[v]);
-    if (mesh.materials.empty() || mesh.triangle_parts.size() != mesh.triangle_count())
-        return albedo;
-
-    // Each vertex's material: that of the first triangle using it.
-    std::vector<int> material(n, -1);
+std::vector<int> vertex_materials(const Mesh& mesh) {
+    std::vector<int> material(mesh.vertex_count(), -1);
+    if (mesh.triangle_parts.size() != mesh.triangle_count())
+        return material;
     for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
         const std::uint32_t part = mesh.triangle_parts[t];
         const int m = part < mesh.parts.size() ? mesh.parts[part].material : -1;
@@ -57,7 +49,10 @@ std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const glm::vec3& fallback) 
                 material[v] = m;
         }
     }
-    // Each material's image, loaded once; one that does not load is left out.
+    return material;
+}
+
+std::vector<Image> base_color_images(const Mesh& mesh) {
     std::vector<Image> images(mesh.materials.size());
     for (std::size_t m = 0; m < mesh.materials.size(); ++m) {
         const MeshMaterial& mm = mesh.materials[m];
@@ -71,9 +66,23 @@ std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const glm::vec3& fallback) 
             else if (!file.empty() && std::filesystem::is_regular_file(file, ec))
                 images[m] = load_image(file);
         } catch (const Error&) {
-            images[m] = Image();
+            images[m] = Image(); // left out, as a missing file
         }
     }
+    return images;
+}
+
+std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const glm::vec3& fallback, bool sample_images) {
+    const std::size_t n = mesh.vertex_count();
+    const bool colors = mesh.colors.size() == n;
+    std::vector<glm::vec3> albedo(n, fallback);
+    if (colors)
+        for (std::size_t v = 0; v < n; ++v)
+            albedo[v] = glm::vec3(mesh.colors[v]);
+    if (mesh.materials.empty() || mesh.triangle_parts.size() != mesh.triangle_count())
+        return albedo;
+    const std::vector<int> material = vertex_materials(mesh);
+    const std::vector<Image> images = sample_images ? base_color_images(mesh) : std::vector<Image>(mesh.materials.size());
     for (std::size_t v = 0; v < n; ++v) {
         if (material[v] < 0)
             continue;

@@ -175,8 +175,21 @@ struct ModelRenderer::Impl {
     ShLight light;
     bool have_light = false;
     SkyLightSettings light_settings;
-    // Per-vertex (visibility, A): visibility of the sun (shadow=vertex) or of one rule direction.
+    // Per-vertex (visibility, A, u, v): visibility of the sun (shadow=vertex)
+    // or of one rule direction, the shading coefficient, and the UV of the
+    // vertex's base colour image.
     std::vector<float> extra;
+    // The base colour images, sampled per pixel: one texture per material
+    // (white where a material has none), the triangles sorted by material
+    // into runs of the index buffer. Off once set_albedo() replaces the albedo.
+    struct Run {
+        int material = -1;
+        std::size_t first = 0, count = 0; // indices
+    };
+    std::vector<Run> runs;
+    std::vector<Texture> base_color;
+    Texture white;
+    bool textured = false;
     glm::vec3 visibility_for{0.0f};
     bool have_visibility = false;
     ModelShading uploaded_shading = ModelShading::Prt;
@@ -253,7 +266,7 @@ struct ModelRenderer::Impl {
         const auto t0 = Clock::now();
         const std::vector<float> v = sun_visibility(model->mesh, direction, *queries);
         for (std::size_t i = 0; i < v.size(); ++i)
-            extra[2 * i] = v[i];
+            extra[4 * i] = v[i];
         upload_extra();
         visibility_for = direction;
         have_visibility = true;
@@ -544,17 +557,45 @@ std::unique_ptr<ModelRenderer::Impl> make_impl(const ViewerModel& model, const S
     upload(m.normals, GL_ARRAY_BUFFER, mesh.normals.data(), n * sizeof(glm::vec3));
     glEnableVertexAttribArray(1);
     glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
-    upload(m.albedo, GL_ARRAY_BUFFER, model.albedo.data(), n * sizeof(glm::vec3));
+    // The base colour images are sampled per pixel when the model's albedo is
+    // mesh_albedo()'s (the default): the vertices then carry the rest of it.
+    std::vector<Image> images;
+    std::vector<glm::vec3> vertex_albedo = model.albedo;
+    if (!mesh.materials.empty() && mesh.triangle_parts.size() == mesh.triangle_count()) {
+        images = base_color_images(mesh);
+        const bool any = std::any_of(images.begin(), images.end(), [](const Image& i) { return i.width > 0; });
+        if (any && mesh_albedo(mesh) == model.albedo) {
+            m.textured = true;
+            vertex_albedo = mesh_albedo(mesh, glm::vec3(0.8f), false);
+        } else {
+            images.clear();
+        }
+    }
+    upload(m.albedo, GL_ARRAY_BUFFER, vertex_albedo.data(), n * sizeof(glm::vec3));
     glEnableVertexAttribArray(2);
     glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
-    // (visibility, A) per vertex; A = 1 when the transfer has no shading coefficient.
-    m.extra.assign(2 * n, 0.0f);
+    // (visibility, A, u, v) per vertex; A = 1 when the transfer has no shading coefficient.
+    m.extra.assign(4 * n, 0.0f);
     const bool have_a = model.transfer.shading.size() == n;
     for (std::size_t v = 0; v < n; ++v)
-        m.extra[2 * v + 1] = have_a ? model.transfer.shading[v] : 1.0f;
+        m.extra[4 * v + 1] = have_a ? model.transfer.shading[v] : 1.0f;
+    const std::vector<int> material = vertex_materials(mesh);
+    if (m.textured)
+        for (std::size_t v = 0; v < n; ++v) {
+            if (material[v] < 0)
+                continue;
+            const auto set = std::size_t(std::max(mesh.materials[std::size_t(material[v])].base_color_texcoord, 0));
+            if (set >= mesh.texcoords.size() || mesh.texcoords[set].size() != n)
+                continue;
+            const glm::vec2 uv = mesh.texcoords[set][v];
+            if (std::isfinite(uv.x) && std::isfinite(uv.y) && std::abs(uv.x) < 1e6f && std::abs(uv.y) < 1e6f) {
+                m.extra[4 * v + 2] = uv.x;
+                m.extra[4 * v + 3] = uv.y;
+            }
+        }
     upload(m.vertex_extra, GL_ARRAY_BUFFER, m.extra.data(), m.extra.size() * sizeof(float));
     glEnableVertexAttribArray(3);
-    glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+    glVertexAttribPointer(3, 4, GL_FLOAT, GL_FALSE, 0, nullptr);
     m.transfer = make_buffer();
     glBindBuffer(GL_ARRAY_BUFFER, m.transfer.get());
     for (int i = 0; i < m.attributes; ++i) {
@@ -562,8 +603,48 @@ std::unique_ptr<ModelRenderer::Impl> make_impl(const ViewerModel& model, const S
         glVertexAttribPointer(GLuint(4 + i), 4, GL_FLOAT, GL_FALSE, GLsizei(m.attributes * 4 * sizeof(float)),
                               reinterpret_cast<const void*>(std::uintptr_t(i) * 4 * sizeof(float)));
     }
-    upload(m.indices, GL_ELEMENT_ARRAY_BUFFER, mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t));
+    // The triangles in runs of one material each (in mesh order within a run).
+    std::vector<std::uint32_t> indices = mesh.indices;
+    if (m.textured) {
+        std::vector<std::pair<int, std::uint32_t>> order(mesh.triangle_count());
+        for (std::size_t t = 0; t < order.size(); ++t) {
+            const std::uint32_t part = mesh.triangle_parts[t];
+            const int mat = part < mesh.parts.size() ? mesh.parts[part].material : -1;
+            order[t] = {mat >= 0 && std::size_t(mat) < mesh.materials.size() ? mat : -1, std::uint32_t(t)};
+        }
+        std::stable_sort(order.begin(), order.end(),
+                         [](const auto& a, const auto& b) { return a.first < b.first; });
+        for (std::size_t k = 0; k < order.size(); ++k) {
+            for (int c = 0; c < 3; ++c)
+                indices[3 * k + std::size_t(c)] = mesh.indices[3 * std::size_t(order[k].second) + std::size_t(c)];
+            if (m.runs.empty() || m.runs.back().material != order[k].first)
+                m.runs.push_back({order[k].first, 3 * k, 0});
+            m.runs.back().count += 3;
+        }
+    } else {
+        m.runs.push_back({-1, 0, indices.size()});
+    }
+    upload(m.indices, GL_ELEMENT_ARRAY_BUFFER, indices.data(), indices.size() * sizeof(std::uint32_t));
     glBindVertexArray(0);
+    // A white 1×1 texture for what has no image, and one texture per image (linear RGB, mipmapped, repeating).
+    auto make_rgb = [](const float* rgb, int w, int h) {
+        Texture t = make_texture();
+        glBindTexture(GL_TEXTURE_2D, t.get());
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB16F, w, h, 0, GL_RGB, GL_FLOAT, rgb);
+        glGenerateMipmap(GL_TEXTURE_2D);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+        return t;
+    };
+    const float one[3] = {1.0f, 1.0f, 1.0f};
+    m.white = make_rgb(one, 1, 1);
+    for (const Image& img : images)
+        m.base_color.push_back(img.width > 0 && img.height > 0 ? make_rgb(img.rgb.data(), img.width, img.height)
+                                                               : Texture());
+    glBindTexture(GL_TEXTURE_2D, 0);
     check_gl("model upload");
     return impl;
 }
@@ -627,6 +708,7 @@ void ModelRenderer::set_albedo(std::span<const glm::vec3> albedo) {
         throw Error(fmt::format("{} albedo values for {} vertices", albedo.size(), m.model->mesh.vertex_count()),
                     "albedo");
     m.make_current();
+    m.textured = false; // the new albedo is the whole albedo
     glBindBuffer(GL_ARRAY_BUFFER, m.albedo.get());
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(albedo.size() * sizeof(glm::vec3)), albedo.data(), GL_STATIC_DRAW);
 }
@@ -711,9 +793,17 @@ void ModelRenderer::Impl::draw_frame(const ModelViewSettings& st, int w, int h, 
     glUniform1f(glGetUniformLocation(p, "u_shadow_texel"), 1.0f / float(kShadowMapSize));
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
+    glUniform1i(glGetUniformLocation(p, "u_base_color"), 3);
+    glActiveTexture(GL_TEXTURE3);
     glBindVertexArray(vao.get());
-    glDrawElements(GL_TRIANGLES, GLsizei(model->mesh.indices.size()), GL_UNSIGNED_INT, nullptr);
+    for (const Run& run : runs) {
+        const bool image = textured && run.material >= 0 && base_color[std::size_t(run.material)].get() != 0;
+        glBindTexture(GL_TEXTURE_2D, image ? base_color[std::size_t(run.material)].get() : white.get());
+        glDrawElements(GL_TRIANGLES, GLsizei(run.count), GL_UNSIGNED_INT,
+                       reinterpret_cast<const void*>(run.first * sizeof(std::uint32_t)));
+    }
     glBindVertexArray(0);
+    glActiveTexture(GL_TEXTURE0);
     glFinish();
     check_gl("model draw");
     if (stats) {

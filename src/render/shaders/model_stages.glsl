@@ -63,7 +63,7 @@ void main() {
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec3 a_albedo;
-layout(location = 3) in vec2 a_extra; // (visibility of the sun or of one direction, shading coefficient A)
+layout(location = 3) in vec4 a_extra; // (visibility of the sun or of one direction, shading coefficient A, UV)
 layout(location = 4) in vec4 a_prt[SKYBAKE_PRT_ATTRIBUTES];
 uniform mat4 u_clip_from_world;
 uniform vec3 u_light[SKYBAKE_SH_COUNT];
@@ -76,6 +76,7 @@ out vec3 v_normal;
 out vec3 v_world;
 out float v_visible;
 out float v_a;
+out vec2 v_uv;
 void main() {
     // relight(): B = ρ Σ L_lm T_lm + ρ (1/π) (n·s)+ E_sun V_sun.
     vec4 prt[SKYBAKE_PRT_ATTRIBUTES];
@@ -88,6 +89,7 @@ void main() {
     v_world = a_position;
     v_visible = a_extra.x;
     v_a = a_extra.y;
+    v_uv = a_extra.zw;
     gl_Position = u_clip_from_world * vec4(a_position, 1.0);
 }
 #elif defined(SKYBAKE_STAGE_MODEL_FS)
@@ -98,6 +100,8 @@ in vec3 v_normal;
 in vec3 v_world;
 in float v_visible;
 in float v_a;
+in vec2 v_uv;
+uniform sampler2D u_base_color;      // the material's base colour image (linear), white if none
 uniform int u_mode;   // 0: diffuse, 1: diffuse + DPRT glossy, 2: visibility of one direction
 uniform int u_shadow; // the sun's shadow: 0 shadow map, 1 per vertex, 2 none
 uniform vec3 u_sun;
@@ -122,20 +126,24 @@ float sb_sun_shadow(vec3 p, vec3 n) {
 }
 
 void main() {
+    // The albedo is the vertex's (factor × colour) × the image at this pixel;
+    // the vertex stage's terms carry the first factor.
+    vec3 image = texture(u_base_color, v_uv).rgb;
+    vec3 albedo = v_albedo * image;
     if (u_mode == 2) {
-        o_colour = vec4(v_albedo * mix(0.04, 1.0, v_visible), 1.0);
+        o_colour = vec4(albedo * mix(0.04, 1.0, v_visible), 1.0);
         return;
     }
-    vec3 b = v_sky;
+    vec3 b = v_sky * image;
     float len = length(v_normal);
     vec3 n = len > 0.0 ? v_normal / len : vec3(0.0, 1.0, 0.0);
     if (u_shadow == 1) {
-        b += v_sun_vertex;
+        b += v_sun_vertex * image;
     } else if (any(greaterThan(u_sun_irradiance, vec3(0.0)))) {
         float ns = dot(n, u_sun);
         if (ns > 0.0) {
             float v = u_shadow == 0 ? sb_sun_shadow(v_world, n) : 1.0;
-            b += v_albedo * (0.318309886 * ns * v) * u_sun_irradiance;
+            b += albedo * (0.318309886 * ns * v) * u_sun_irradiance;
         }
     }
     if (u_mode == 1 && len > 0.0) {
