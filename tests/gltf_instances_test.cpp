@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.h"
+#include "skybake/files.h"
 #include "skybake/bake.h"
 #include "skybake/gltf_asset.h"
 #include "skybake/mesh.h"
@@ -190,7 +191,14 @@ TEST(GltfInstances, CliKeepsTheDocument) {
     std::uint32_t json_len;
     std::memcpy(&json_len, data.data() + 12, 4);
     const Json j = Json::parse(data.substr(20, json_len));
-    EXPECT_EQ(j["images"][0]["uri"], "CesiumLogoFlat.png");
+    // The .glb carries the box's image: the file travels alone.
+    EXPECT_FALSE(j["images"][0].contains("uri")) << j["images"].dump();
+    EXPECT_EQ(j["images"][0]["mimeType"], "image/png");
+    const Json& view = j["bufferViews"][j["images"][0]["bufferView"].get<std::size_t>()];
+    const std::string png = skybake::read_file(dir / "CesiumLogoFlat.png");
+    std::uint32_t bin_at = 20 + json_len + 8;
+    EXPECT_EQ(view["byteLength"].get<std::size_t>(), png.size());
+    EXPECT_EQ(data.substr(bin_at + view["byteOffset"].get<std::size_t>(), png.size()), png);
     EXPECT_EQ(j["materials"].size(), 1u);
     EXPECT_TRUE(j["meshes"][0]["primitives"][0]["attributes"].contains("TEXCOORD_0"));
     EXPECT_TRUE(j["meshes"][0]["primitives"][0]["attributes"].contains("_AO"));

@@ -9,6 +9,7 @@
 #include "skybake/gltf_asset.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -21,6 +22,7 @@
 
 #include "io/gltf_schema.h"
 #include "io/mesh_internal.h"
+#include "io/texture_path.h"
 #include "skybake/error.h"
 #include "skybake/files.h"
 
@@ -92,6 +94,22 @@ std::string relocate_uri(const std::string& uri, const std::filesystem::path& fr
     for (char c : rel.generic_string())
         prefix += c == ' ' ? std::string("%20") : std::string(1, c);
     return prefix + "/" + uri;
+}
+
+// The MIME type glTF names for an image file's extension; empty for another.
+std::string image_mime_type(const std::string& uri) {
+    std::string ext = std::filesystem::path(uri).extension().string();
+    for (char& c : ext)
+        c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".png")
+        return "image/png";
+    if (ext == ".jpg" || ext == ".jpeg")
+        return "image/jpeg";
+    if (ext == ".webp")
+        return "image/webp";
+    if (ext == ".ktx2")
+        return "image/ktx2";
+    return {};
 }
 
 bool is_direction(const VertexAttribute& a) {
@@ -312,13 +330,34 @@ void GltfAsset::save(const std::filesystem::path& path) const {
             append(&colors, "COLOR_0");
     }
 
-    // The input's images, as seen from the output's folder (before the AO
-    // image, whose URI is already written from there).
+    // The input's images (before the AO image, whose URI is already written
+    // from the output's folder). A .glb embeds each one whose file exists, so
+    // that the file travels alone; otherwise the URI is rewritten to be seen
+    // from the output's folder.
     const std::filesystem::path out_dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
     if (doc.contains("images") && doc["images"].is_array())
-        for (Json& image : doc["images"])
-            if (image.contains("uri") && image["uri"].is_string())
-                image["uri"] = relocate_uri(image["uri"].get<std::string>(), s.source_dir, out_dir);
+        for (Json& image : doc["images"]) {
+            if (!image.contains("uri") || !image["uri"].is_string())
+                continue;
+            const std::string uri = image["uri"].get<std::string>();
+            const std::string mime = image_mime_type(uri);
+            const bool local = !uri.empty() && uri.rfind("data:", 0) != 0 && uri.find("://") == std::string::npos;
+            const std::filesystem::path file = s.source_dir / io::percent_decode(uri);
+            std::error_code ec;
+            if (ext == ".glb" && local && !mime.empty() && std::filesystem::is_regular_file(file, ec)) {
+                const std::string bytes = read_file(file);
+                while (bin.size() % 4)
+                    bin.push_back(0);
+                const std::size_t offset = bin.size();
+                bin.insert(bin.end(), bytes.begin(), bytes.end());
+                views.push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes.size()}});
+                image.erase("uri");
+                image["bufferView"] = views.size() - 1;
+                image["mimeType"] = mime;
+            } else {
+                image["uri"] = relocate_uri(uri, s.source_dir, out_dir);
+            }
+        }
 
     if (!s.occlusion_image.empty()) {
         // One image and texture, referenced from every baked primitive's

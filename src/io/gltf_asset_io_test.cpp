@@ -131,6 +131,14 @@ void strip_additions(Json& out, const Json& in, std::size_t in_bin_bytes) {
             node["mesh"] = original;
         }
     }
+    // A .glb embeds the images the input names by URI (GlbEmbedsTheImagesItFinds checks the bytes).
+    if (in.contains("images"))
+        for (std::size_t i = 0; i < in["images"].size() && i < out["images"].size(); ++i)
+            if (in["images"][i].contains("uri") && out["images"][i].contains("bufferView")) {
+                EXPECT_GE(out["images"][i]["bufferView"].get<std::size_t>(), n_views) << "image " << i;
+                EXPECT_TRUE(out["images"][i].contains("mimeType")) << "image " << i;
+                out["images"][i] = in["images"][i];
+            }
     out["meshes"].get_ref<Json::array_t&>().resize(n_meshes);
     if (n_acc == 0)
         out.erase("accessors");
@@ -247,11 +255,42 @@ TEST(GltfAsset, ImageUrisFollowTheOutputFolder) {
     fill(asset);
     const fs::path elsewhere = temp_dir("box-moved-out") / "sub";
     fs::create_directories(elsewhere);
-    asset.save(elsewhere / "out.glb");
-    const Json out = read_document(elsewhere / "out.glb").json;
+    asset.save(elsewhere / "out.gltf");
+    const Json out = read_document(elsewhere / "out.gltf").json;
     const std::string uri = out["images"][0]["uri"];
     EXPECT_NE(uri, "CesiumLogoFlat.png");
     EXPECT_TRUE(fs::is_regular_file(elsewhere / uri)) << uri;
+}
+
+// A .glb embeds the images whose files exist (bufferView + mimeType, the
+// same bytes), and keeps the URI of one that does not, seen from its folder.
+TEST(GltfAsset, GlbEmbedsTheImagesItFinds) {
+    const fs::path input = copy_sample("BoxTextured-glTF", "BoxTextured.gltf", "box-embedded");
+    GltfAsset asset = GltfAsset::load(input);
+    fill(asset);
+    const fs::path elsewhere = temp_dir("box-embedded-out");
+    asset.save(elsewhere / "out.glb");
+    const auto d = read_document(elsewhere / "out.glb");
+    const Json& image = d.json["images"][0];
+    EXPECT_FALSE(image.contains("uri")) << image.dump();
+    EXPECT_EQ(image["mimeType"], "image/png");
+    const Json& view = d.json["bufferViews"][image["bufferView"].get<std::size_t>()];
+    const std::string png = read_file(input.parent_path() / "CesiumLogoFlat.png");
+    ASSERT_EQ(view["byteLength"].get<std::size_t>(), png.size());
+    EXPECT_EQ(d.bin.substr(view["byteOffset"].get<std::size_t>(), png.size()), png);
+    EXPECT_FALSE(view.contains("target")); // an image's view is not a vertex buffer
+    // Its base colour still reads back through the loader.
+    const Mesh back = load_mesh(elsewhere / "out.glb");
+    ASSERT_FALSE(back.materials.empty());
+    EXPECT_FALSE(back.materials[0].base_color_image.empty());
+
+    fs::remove(input.parent_path() / "CesiumLogoFlat.png");
+    GltfAsset missing = GltfAsset::load(input);
+    fill(missing);
+    missing.save(elsewhere / "missing.glb");
+    const Json j = read_document(elsewhere / "missing.glb").json;
+    ASSERT_TRUE(j["images"][0].contains("uri")) << j["images"].dump();
+    EXPECT_FALSE(j["images"][0].contains("bufferView"));
 }
 
 TEST(GltfAsset, RefusesOtherFormatsAndChangedMeshes) {

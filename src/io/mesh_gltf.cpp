@@ -31,6 +31,7 @@
 
 #include "io/mesh_internal.h"
 #include "skybake/error.h"
+#include "io/texture_path.h"
 #include "skybake/files.h"
 
 namespace skybake::io {
@@ -95,21 +96,6 @@ bool keep_embedded_image(tinygltf::Image* image, const int index, std::string*, 
     if (user && data && size > 0 && (image->bufferView >= 0 || image->uri.rfind("data:", 0) == 0))
         static_cast<EmbeddedImages*>(user)->bytes[index].assign(data, data + size);
     return true;
-}
-
-// "My%20File.png" -> "My File.png" (RFC 3986 percent-encoding).
-std::string percent_decode(const std::string& uri) {
-    std::string out;
-    for (std::size_t i = 0; i < uri.size(); ++i) {
-        if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
-            std::isxdigit(static_cast<unsigned char>(uri[i + 2]))) {
-            out += char(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
-            i += 2;
-        } else {
-            out += uri[i];
-        }
-    }
-    return out;
 }
 
 struct AccessorView {
@@ -426,7 +412,7 @@ public:
                     }
                 }
                 if (mm.base_color_image.empty() && !uri.empty() && uri.rfind("data:", 0) != 0 && !base_dir_.empty()) {
-                    const std::string decoded = percent_decode(uri);
+                    const std::string decoded = io::percent_decode(uri);
                     mm.base_color_texture = (std::filesystem::path(base_dir_) / decoded).lexically_normal().string();
                 }
             }

@@ -1,5 +1,6 @@
 #include "io/texture_path.h"
 
+#include <cctype>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -47,6 +48,20 @@ std::optional<std::filesystem::path> find_texture(std::string_view written, cons
                 return (base / tail).lexically_normal();
     }
     return std::nullopt;
+}
+
+std::string percent_decode(std::string_view uri) {
+    const auto hex = [](char c) { return std::isxdigit(static_cast<unsigned char>(c)) != 0; };
+    std::string out;
+    for (std::size_t i = 0; i < uri.size(); ++i) {
+        if (uri[i] == '%' && i + 2 < uri.size() && hex(uri[i + 1]) && hex(uri[i + 2])) {
+            out += char(std::stoi(std::string(uri.substr(i + 1, 2)), nullptr, 16));
+            i += 2;
+        } else {
+            out += uri[i];
+        }
+    }
+    return out;
 }
 
 } // namespace skybake::io

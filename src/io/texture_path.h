@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <string>
 #include <string_view>
 
 namespace skybake::io {
@@ -16,5 +17,8 @@ namespace skybake::io {
 //      models/FBX/spider.fbx is found as models/OBJ/wood.jpg.
 // nullopt when none exists (or model_dir is empty and the path is relative).
 std::optional<std::filesystem::path> find_texture(std::string_view written, const std::filesystem::path& model_dir);
+
+// "My%20File.png" -> "My File.png" (RFC 3986 percent-encoding, as glTF URIs use).
+std::string percent_decode(std::string_view uri);
 
 } // namespace skybake::io
