@@ -31,10 +31,16 @@ namespace {
 constexpr std::uint64_t kDepthBytes = std::uint64_t(256) << 20;
 // GPU memory for one chunk's bits and vertex records.
 constexpr std::uint64_t kChunkBytes = std::uint64_t(256) << 20;
-// The near plane of the cube faces, as a fraction of the far plane. The ray
-// origin is already past the vertex's own surfaces (the driver's step and
-// offset), so the near plane only has to keep the projection finite.
-constexpr float kNearFraction = 1e-6f;
+// The near plane of the cube faces, as a fraction of the far plane. It must
+// lie closer than any surface a ray can meet: the driver's step off a vertex
+// is only 2^-15 of its coordinates (bake::rounding_step()), so near the world
+// origin a blocker that touches the vertex (a wall at the foot of which a
+// ground vertex lies) is a few 1e-6 of the scene away, and a near plane at
+// 1e-6 of the far one clipped it away: those vertices read open. The depth
+// is written linearly (gl_FragDepth), and x and y do not depend on the near
+// plane, so a tiny one costs no precision; 2^-40 keeps it positive and
+// finite in float for any far plane the batch can have.
+constexpr float kNearFraction = 0x1p-40f;
 constexpr int kFaces = 5;
 
 // The std430 layout of `Vertex` in raster_visibility.glsl.
@@ -417,7 +423,7 @@ void RasterTracer::trace_cube(const TraceChunk& chunk) {
         if (std::isfinite(rule.t_max))
             far = std::min(far, rule.t_max * 1.001f);
         far = std::max(far, 1e-30f);
-        const float near = far * kNearFraction;
+        const float near = std::max(far * kNearFraction, std::numeric_limits<float>::min());
         const glm::mat4 top = glm::frustum(-near, near, -near, near, near, far);
         const glm::mat4 side = glm::frustum(-near, near, 0.0f, near, near, far); // the half above the horizon
         for (std::uint32_t i = 0; i < count; ++i) {
