@@ -175,6 +175,11 @@ TransferReport bake_transfer(Mesh& mesh, const SphereRule& rule, VisibilityTrace
 std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const glm::vec3& fallback = glm::vec3(0.8f),
                                    bool images = true);
 
+// The same with the base colour images already decoded (base_color_images();
+// a missing or empty entry leaves that material's image out).
+std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const std::vector<Image>& images,
+                                   const glm::vec3& fallback = glm::vec3(0.8f));
+
 // Each material's base colour image, decoded (linear RGB), in the order of
 // Mesh::materials; an empty Image where a material has none or its file does
 // not load.

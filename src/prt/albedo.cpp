@@ -73,6 +73,10 @@ std::vector<Image> base_color_images(const Mesh& mesh) {
 }
 
 std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const glm::vec3& fallback, bool sample_images) {
+    return mesh_albedo(mesh, sample_images ? base_color_images(mesh) : std::vector<Image>(), fallback);
+}
+
+std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const std::vector<Image>& decoded, const glm::vec3& fallback) {
     const std::size_t n = mesh.vertex_count();
     const bool colors = mesh.colors.size() == n;
     std::vector<glm::vec3> albedo(n, fallback);
@@ -82,13 +86,14 @@ std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const glm::vec3& fallback, 
     if (mesh.materials.empty() || mesh.triangle_parts.size() != mesh.triangle_count())
         return albedo;
     const std::vector<int> material = vertex_materials(mesh);
-    const std::vector<Image> images = sample_images ? base_color_images(mesh) : std::vector<Image>(mesh.materials.size());
+    const Image none;
     for (std::size_t v = 0; v < n; ++v) {
         if (material[v] < 0)
             continue;
         const MeshMaterial& mm = mesh.materials[std::size_t(material[v])];
         glm::vec3 a = glm::vec3(mm.base_color);
-        const Image& img = images[std::size_t(material[v])];
+        const std::size_t m = std::size_t(material[v]);
+        const Image& img = m < decoded.size() ? decoded[m] : none;
         const auto set = std::size_t(std::max(mm.base_color_texcoord, 0));
         if (img.width > 0 && img.height > 0 && set < mesh.texcoords.size() && mesh.texcoords[set].size() == n &&
             std::isfinite(mesh.texcoords[set][v].x) && std::isfinite(mesh.texcoords[set][v].y) &&

@@ -564,7 +564,7 @@ std::unique_ptr<ModelRenderer::Impl> make_impl(const ViewerModel& model, const S
     if (!mesh.materials.empty() && mesh.triangle_parts.size() == mesh.triangle_count()) {
         images = base_color_images(mesh);
         const bool any = std::any_of(images.begin(), images.end(), [](const Image& i) { return i.width > 0; });
-        if (any && mesh_albedo(mesh) == model.albedo) {
+        if (any && mesh_albedo(mesh, images) == model.albedo) {
             m.textured = true;
             vertex_albedo = mesh_albedo(mesh, glm::vec3(0.8f), false);
         } else {
