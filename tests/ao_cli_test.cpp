@@ -131,10 +131,10 @@ TEST(AoCli, BadInputIsOneLineAndNoOutput) {
         expect_one_line_error(run_cli({"ao", in, "-o", out, "--device", "cuda"}), 1, "on the CPU");
         expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "cuda"}), 1, "on the CPU");
     }
-    expect_one_line_error(run_cli({"ao", in, "-o", out, "--method", "per-vertex"}), 2, "--device cuda");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--method", "per-vertex"}), 2, "cuda backend's");
     expect_one_line_error(run_cli({"ao", in, "-o", out, "--device", "cuda", "--method", "octree"}), 2, "--method");
     expect_one_line_error(run_cli({"ao", in, "-o", out, "--backend", "optix"}), 2, "--backend");
-    expect_one_line_error(run_cli({"ao", in, "-o", out, "--device", "cuda", "--backend", "embree"}), 2, "--backend");
+    expect_one_line_error(run_cli({"ao", in, "-o", out, "--device", "cuda", "--backend", "embree"}), 2, "--device");
     expect_one_line_error(run_cli({"ao", in, "-o", out, "--device", "tpu"}), 2, "--device");
     expect_one_line_error(run_cli({"ao", in, "-o", dir + "/out.obj"}), 2, "--output");
     expect_one_line_error(run_cli({"ao", in, "-o", out, "--preview", dir + "/p.jpg"}), 2, "--preview");

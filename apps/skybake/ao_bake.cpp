@@ -38,7 +38,7 @@ constexpr const char* kDefaultRule = "lebedev:590";
 struct AoOptions {
     std::string input, output;
     std::string rule = kDefaultRule;
-    std::string device = "cpu";
+    std::string device = "auto";
     std::string backend; // empty: embree on the CPU, cuda on the GPU
     std::string method; // empty: the backend's default (bvh; cube for raster)
     std::uint32_t resolution = 0; // raster: 0 = the method's default
@@ -104,18 +104,15 @@ nlohmann::json stats(const std::vector<float>& v) {
     return {{"min", lo}, {"mean", sum / double(v.size())}, {"max", hi}};
 }
 
-// The backend for --device and --backend: one way to say where the work runs
-// (--device, as for the sky commands), and --backend to pick a CPU backend.
-std::string backend_name(const AoOptions& o) {
-    const Device device = parse_flag("--device", [&] { return parse_device(o.device); });
-    if (o.backend.empty())
-        return device == Device::Cuda ? "cuda" : "embree";
-    if (o.backend != "embree" && o.backend != "brute" && o.backend != "cuda" && o.backend != "raster")
-        throw UsageError(fmt::format("unknown backend '{}'; use embree, brute, cuda or raster", o.backend),
-                         "--backend");
-    if (device == Device::Cuda && o.backend != "cuda")
-        throw UsageError(fmt::format("--backend {} runs on the CPU, but --device is cuda", o.backend), "--backend");
-    return o.backend;
+// The tracer for --device, --backend, --method and --resolution, resolved by
+// the library (its errors name the fields, which main() maps to the flags).
+TracerChoice tracer_choice(const AoOptions& o) {
+    TracerRequest r;
+    r.device = o.device;
+    r.backend = o.backend;
+    r.method = o.method;
+    r.resolution = o.resolution;
+    return parse_flags([&] { return resolve_tracer(r); });
 }
 
 // One bake: INPUT to OUTPUT. `job`: spread over the ranks of an MPI job.
@@ -128,21 +125,8 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
                                      "design, fibonacci or mc rule for ambient occlusion",
                                      rule.spec),
                          "--rule");
-    const std::string backend_id = backend_name(o);
-    const TraceMethod method = o.method.empty() ? default_trace_method(backend_id)
-                                                : parse_flag("--method", [&] { return parse_trace_method(o.method); });
-    const bool raster_method = method == TraceMethod::Cube || method == TraceMethod::Directional;
-    if (backend_id == "raster" && !raster_method)
-        throw UsageError(fmt::format("--method {} is not a raster method; use cube (default) or directional", o.method),
-                         "--method");
-    if (backend_id != "raster" && raster_method)
-        throw UsageError(fmt::format("--method {} is a method of the raster backend; add --backend raster", o.method),
-                         "--method");
-    if (method != TraceMethod::Bvh && !raster_method && backend_id != "cuda")
-        throw UsageError(fmt::format("--method {} is a method of the GPU backend; add --device cuda", o.method),
-                         "--method");
-    if (backend_id != "raster")
-        refuse_if_given(sub, "--resolution", "without --backend raster");
+    const TracerChoice choice = tracer_choice(o);
+    const TraceMethod method = choice.method;
     if (method == TraceMethod::Directional && std::isfinite(o.max_distance))
         throw UsageError("the directional method has no maximum distance; use --method cube", "--max-distance");
     if (method == TraceMethod::Directional && rule.rotate_per_vertex)
@@ -174,8 +158,9 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
                              "--output");
     }
     // no GPU or GL: exit 1; in a job, each rank traces with its own
-    const auto tracer = job_tracer(make_visibility_tracer(backend_id, method, o.resolution), job);
-    const std::uint32_t resolution = o.resolution                  ? o.resolution
+    const auto tracer = job_tracer(make_visibility_tracer(choice), job);
+    const std::uint32_t resolution = !choice.backend->resolution  ? 0
+                                     : o.resolution                ? o.resolution
                                      : method == TraceMethod::Cube ? kRasterCubeResolution
                                                                    : kRasterDirectionalResolution;
 
@@ -274,10 +259,9 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
                             {"output", o.output},
                             {"backend", r.backend},
                             {"method", r.method},
-                            {"device", backend_id == "cuda" ? "cuda" : backend_id == "raster" ? "opengl" : "cpu"},
+                            {"device", choice.device},
                             {"gpu", device.empty() ? nlohmann::json(nullptr) : nlohmann::json(device)},
-                            {"resolution", backend_id == "raster" ? nlohmann::json(resolution)
-                                                                  : nlohmann::json(nullptr)},
+                            {"resolution", resolution ? nlohmann::json(resolution) : nlohmann::json(nullptr)},
                             {"rule", r.rule},
                             {"directions", r.directions},
                             {"vertices", r.vertices},
@@ -338,10 +322,10 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
          "{} {:.2f} s",
          r.vertices, r.triangles, r.rule, r.directions, r.backend,
          method == TraceMethod::Bvh ? ""
-         : backend_id == "raster"   ? fmt::format(" {} {}", r.method, resolution)
+         : resolution != 0          ? fmt::format(" {} {}", r.method, resolution)
                                     : " " + r.method,
          device.empty() ? "" : " on " + device, r.rays, r.seconds, r.rays_per_second() * 1e-6,
-         backend_id == "raster" ? "mesh upload" : "BVH", r.build_seconds);
+         resolution != 0 ? "mesh upload" : "BVH", r.build_seconds);
     if (r.negative_weights)
         info("note: {} has negative weights; {} vertices had sums outside [0, 1], clamped", r.rule,
              r.clamped_vertices);
@@ -415,10 +399,8 @@ void run_batch(const AoOptions& o, const CLI::App& sub, bool job) {
         throw UsageError("--batch needs --out-dir DIR for the outputs", "--out-dir");
     // The flags are checked once, before any asset.
     parse_flag("--rule", [&] { return parse_rule(o.rule); });
-    backend_name(o);
+    tracer_choice(o);
     parse_flag("--back-faces", [&] { return parse_back_faces(o.back_faces); });
-    if (!o.method.empty())
-        parse_flag("--method", [&] { return parse_trace_method(o.method); });
 
     const std::filesystem::path list(o.batch);
     std::vector<std::filesystem::path> assets;
@@ -512,10 +494,8 @@ void add_ao_bake(CLI::App& group) {
                     "Sphere rule, e.g. lebedev:5810, design:t21, fibonacci:1000, mc:4096; add +rotate for a random "
                     "rotation per vertex (see 'sphere list')")
         ->capture_default_str();
-    sub->add_option("--device", o->device, "Where the bake runs: cpu, or cuda (an NVIDIA GPU)")->capture_default_str();
-    sub->add_option("--backend", o->backend,
-                    "Visibility backend: embree (CPU; the default with --device cpu), brute (test oracle, small "
-                    "meshes) or cuda (the default with --device cuda)");
+    sub->add_option("--device", o->device, device_help())->capture_default_str();
+    sub->add_option("--backend", o->backend, backend_help());
     sub->add_option("--method", o->method,
                     "How blockers are found. cuda: bvh (default), per-vertex (every triangle for every ray, the "
                     "seed's naive method) or per-polygon (every triangle, cached in shared memory); raster: cube "

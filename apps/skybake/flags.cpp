@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "core/parse_number.h"
+#include "skybake/visibility.h"
 
 namespace skybake::cli {
 
@@ -190,7 +191,7 @@ std::string flag_for_field(const std::string& where) {
         {"method", "--method"},
         {"backend", "--backend"},
         {"resolution", "--resolution"},
-        {"device", "--device cuda"},
+        {"device", "--device"},
         {"back_faces", "--back-faces"},
         {"preset", "--preset"},
         {"paper_r/paper_m", "--paper-r/--paper-m"},
@@ -231,6 +232,28 @@ std::string flag_for_field(const std::string& where) {
         if (where == field)
             return flag;
     return where;
+}
+
+std::string device_help() {
+    std::string devices;
+    for (const TracerBackend& b : tracer_backends())
+        if (devices.find(b.device) == std::string::npos)
+            devices += ", " + b.device;
+    return fmt::format("Where the bake runs: auto (a CUDA GPU when one answers, else the CPU){}; the device's first "
+                       "backend unless --backend names one",
+                       devices);
+}
+
+std::string backend_help() {
+    std::string text = "Visibility backend (default: the device's first):";
+    for (const TracerBackend& b : tracer_backends()) {
+        std::string methods;
+        for (TraceMethod m : b.methods)
+            methods += std::string(methods.empty() ? "" : ", ") + trace_method_name(m);
+        text += fmt::format(" {} ({}; on {}; methods {})", b.name, b.summary, b.device, methods);
+        text += &b == &tracer_backends().back() ? "." : ";";
+    }
+    return text;
 }
 
 } // namespace skybake::cli

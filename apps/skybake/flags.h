@@ -55,6 +55,20 @@ auto parse_flag(const char* flag, F&& parse) -> decltype(parse()) {
     }
 }
 
+// Runs a library check of several flags at once (resolve_tracer()): its
+// skybake::Error becomes a UsageError naming the flag of the field at fault.
+std::string flag_for_field(const std::string& where);
+template <class F>
+auto parse_flags(F&& parse) -> decltype(parse()) {
+    try {
+        return parse();
+    } catch (const UsageError&) {
+        throw;
+    } catch (const Error& e) {
+        throw UsageError(e.message(), flag_for_field(e.where()));
+    }
+}
+
 // The library names the API field at fault in Error::where() (e.g.
 // "max_distance"); the CLI speaks of flags. The flag that sets `where`, from
 // the one table of the CLI (flags.cpp), or `where` itself when no flag sets
@@ -94,5 +108,10 @@ std::string lower_extension(const std::string& path);
 void refuse_if_given(const CLI::App& sub, const char* flag, const std::string& reason);
 // Whether `flag` was given.
 bool given(const CLI::App& sub, const char* flag);
+
+// --help of --device and --backend, from the registered backends
+// (skybake/visibility.h, [SECTION] Backends).
+std::string device_help();
+std::string backend_help();
 
 } // namespace skybake::cli

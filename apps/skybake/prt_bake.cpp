@@ -1,5 +1,5 @@
 // skybake prt bake INPUT -o OUTPUT.glb|.ply [--order L] [--kind K] [--bounces N] [--rule R] [--backend B]
-//                  [--device D] [--albedo A] [--model prt|shading-coefficient] [--max-distance D] [--json]
+//                  [--device D] [--method M] [--resolution N] [--albedo A] [--model prt|shading-coefficient] [--max-distance D] [--json]
 // Per-vertex diffuse SH transfer (skybake/prt.h), with a JSON sidecar.
 // Under mpirun (or with --mpi) the visibility is spread over the ranks (job.h).
 #include <limits>
@@ -18,7 +18,9 @@ namespace skybake::cli {
 namespace {
 
 struct BakeOpts {
-    std::string input, output, rule = "lebedev:590", kind = "shadowed", model = "prt", albedo, backend, device = "cpu";
+    std::string input, output, rule = "lebedev:590", kind = "shadowed", model = "prt", albedo, backend, method,
+        device = "auto";
+    std::uint32_t resolution = 0;
     int order = 3, bounces = 0;
     double max_distance = std::numeric_limits<double>::infinity();
     bool json = false, mpi = false;
@@ -72,21 +74,20 @@ void run(const BakeOpts& o, const CLI::App& sub) {
     t.model = parse_flag("--model", [&] { return parse_transfer_model(o.model); });
     if (t.model == TransferModel::ShadingCoefficient && o.bounces > 0)
         throw UsageError("the shading-coefficient model has no bounces", "--bounces");
-    const Device device = parse_flag("--device", [&] { return parse_device(o.device); });
-    std::string backend = o.backend.empty() ? (device == Device::Cuda ? "cuda" : "embree") : o.backend;
-    if (backend != "embree" && backend != "brute" && backend != "cuda" && backend != "raster")
-        throw UsageError(fmt::format("unknown backend '{}'; use embree, brute, cuda or raster", backend), "--backend");
-    if (backend == "raster" && t.kind == TransferKind::Interreflected)
-        throw UsageError("interreflection needs closest hits, and the raster backend answers no ray queries; use "
-                         "--backend embree, brute or cuda",
-                         "--backend");
+    TracerRequest request;
+    request.device = o.device;
+    request.backend = o.backend;
+    request.method = o.method;
+    request.resolution = o.resolution;
+    request.closest_hit = t.kind == TransferKind::Interreflected; // the bounces' gathers
+    const TracerChoice choice = parse_flags([&] { return resolve_tracer(request); });
     const bool constant_albedo = !o.albedo.empty();
     const glm::vec3 albedo_value = constant_albedo ? parse_albedo(o.albedo) : glm::vec3(0.8f);
     check_output_path(o.output, {".glb", ".ply"}, "--output");
-    const auto tracer = job_tracer(make_visibility_tracer(backend, default_trace_method(backend)), job);
+    const auto tracer = job_tracer(make_visibility_tracer(choice), job);
     std::unique_ptr<RayQueries> queries;
     if (t.kind == TransferKind::Interreflected)
-        queries = make_ray_queries(backend);
+        queries = make_ray_queries(choice);
     if (job && !job_root() && t.kind == TransferKind::Interreflected) {
         // The bounces run on rank 0, over the gathered words; the other ranks
         // only trace visibility, which the shadowed bake shares.
@@ -168,10 +169,11 @@ void add_prt_bake(CLI::App& group) {
                     "Sphere rule, e.g. lebedev:590, design:t21; +rotate for a per-vertex "
                     "rotation")
         ->capture_default_str();
-    sub->add_option("--device", o->device, "Where the bake runs: cpu, or cuda")->capture_default_str();
-    sub->add_option("--backend", o->backend,
-                    "Visibility backend: embree (default on the CPU), brute, cuda or raster (the depth buffer; no "
-                    "bounces)");
+    sub->add_option("--device", o->device, device_help())->capture_default_str();
+    sub->add_option("--backend", o->backend, backend_help() + " Bounces need a backend with closest hits.");
+    sub->add_option("--method", o->method, "How blockers are found: one of the backend's methods (--backend)");
+    sub->add_option("--resolution", o->resolution, "raster: cube face or depth map size in texels")
+        ->check(CLI::Range(8u, kRasterMaxResolution));
     sub->add_option("--albedo", o->albedo,
                     "Linear RGB albedo, one or three numbers in [0, 1] (default: the material's base colour factor x image x "
                     "vertex colour, as glTF defines it; else the vertex colours; else 0.8)");

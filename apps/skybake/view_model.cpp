@@ -34,20 +34,11 @@ struct ViewModelOpts {
 };
 
 // The panel's Bake button: `skybake prt bake`'s defaults (order 3, shadowed,
-// lebedev:590) on the best backend this build has (CUDA when it has one and
-// a GPU answers, else Embree).
+// lebedev:590) on the device "auto" picks (a CUDA GPU when one answers, else
+// the CPU), as every front end resolves it (resolve_tracer()).
 std::function<ViewerModel(const ViewerModel&)> make_viewer_bake() {
     return [](const ViewerModel& in) {
-        std::unique_ptr<VisibilityTracer> tracer;
-#if defined(SKYBAKE_HAS_CUDA)
-        try {
-            tracer = make_visibility_tracer("cuda", default_trace_method("cuda"));
-        } catch (const Error&) {
-            tracer.reset();
-        }
-#endif
-        if (!tracer)
-            tracer = make_visibility_tracer("embree", default_trace_method("embree"));
+        const auto tracer = make_visibility_tracer(resolve_tracer(TracerRequest{})); // device auto
         ViewerModel out = in;
         TransferOptions t;
         t.order = 3;

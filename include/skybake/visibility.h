@@ -35,6 +35,8 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <span>
@@ -94,7 +96,8 @@ enum class TraceMethod : int {
     Directional = 4, // "directional": raster, one orthographic depth map per rule direction
 };
 const char* trace_method_name(TraceMethod method); // "bvh", "per-vertex", "per-polygon", "cube", "directional"
-// A backend's default method: Cube for "raster", Bvh for the others.
+// A registered backend's default method (its first); throws
+// skybake::Error ("backend") for an unknown name.
 TraceMethod default_trace_method(const std::string& backend);
 // Parses a name above; throws skybake::Error otherwise.
 TraceMethod parse_trace_method(const std::string& text);
@@ -207,19 +210,84 @@ public:
 };
 
 // [SECTION] Backends -----------------------------------------------------------------------
+//
+// Every backend registers itself, as Dear ImGui's backends declare theirs:
+// its name, where it runs, what it can do and its factories. The command
+// line, Python and Blender list their choices from here, and one function,
+// resolve_tracer(), turns a request (device, backend, method, resolution)
+// into a choice with the same rules and messages for every front end.
+//
+// Adding a backend (docs/baking.md, "Adding a backend"): write it in its own
+// folder under src/visibility/, give that folder a function
+//     void skybake_register_<name>_tracer();
+// that calls register_tracer_backend(), and add <name> to
+// SKYBAKE_TRACER_BACKENDS in src/CMakeLists.txt. Nothing else changes.
 
-// Names accepted by the factories below in this build ("cuda" only in builds
-// with CUDA; it still needs a GPU at run time).
+// A backend as registered.
+struct TracerBackend {
+    std::string name;                 // "embree"; unique
+    std::string device;               // where it runs: "cpu", "cuda" or "opengl"
+    std::string summary;              // one line for --help, e.g. "Intel Embree 3 on the CPU"
+    std::vector<TraceMethod> methods; // the methods it owns, its default first; not empty
+    bool closest_hit = false;         // answers RayQueries too (bounces, sun rays, previews)
+    bool resolution = false;          // takes a resolution in texels (TracerRequest::resolution)
+    // Creates a tracer with one of `methods` and a resolution (0: the
+    // backend's default; always 0 for a backend without `resolution`).
+    std::function<std::unique_ptr<VisibilityTracer>(TraceMethod method, std::uint32_t resolution)> make_tracer;
+    // Creates ray queries; empty unless closest_hit.
+    std::function<std::unique_ptr<RayQueries>()> make_ray_queries;
+    // Why it cannot run on this machine now, in one line (no GPU, no
+    // OpenGL 4.3 context, a build without CUDA); empty when it can. May be
+    // slow (it opens a context); empty function: it always can.
+    std::function<std::string()> problem;
+};
+
+// Adds a backend. Throws skybake::Error ("backend") for an empty or taken
+// name, an empty method list or a missing factory.
+void register_tracer_backend(TracerBackend backend);
+// Every registered backend, in registration order (SKYBAKE_TRACER_BACKENDS).
+const std::deque<TracerBackend>& tracer_backends();
+// The backend of that name; throws skybake::Error ("backend") naming the
+// registered ones otherwise.
+const TracerBackend& find_tracer_backend(const std::string& name);
+// The registered names, in registration order.
 std::vector<std::string> visibility_backend_names();
 
-// Create a backend by name. Throw skybake::Error (where: "backend") for an
-// unknown name, for "cuda" in a build without CUDA or on a machine without a
-// CUDA device, for "raster" without an OpenGL 4.3 context, and for "raster"
-// as RayQueries; make_visibility_tracer() also for a method the backend does
-// not have (where: "method"), and for a resolution out of range (where:
-// "resolution"). `resolution` is the raster backend's cube face or depth map
-// size in texels (0: the method's default, kRasterCubeResolution or
-// kRasterDirectionalResolution); other backends take 0 only.
+// Where a bake should run, as a user says it.
+struct TracerRequest {
+    // "auto": a CUDA backend when a CUDA device answers, else the CPU's;
+    // "cpu", "cuda" or "opengl": that device's default backend (the first
+    // registered there), or the backend's device when `backend` is given.
+    std::string device = "auto";
+    std::string backend;          // a registered name; empty: the device's default
+    std::string method;           // one of the backend's; empty: its default
+    std::uint32_t resolution = 0; // texels, for a backend with `resolution`; 0: its default
+    bool closest_hit = false;     // the bake also needs closest hits (bounces)
+};
+
+// A request resolved: a registered backend and one of its methods.
+struct TracerChoice {
+    const TracerBackend* backend = nullptr;
+    TraceMethod method = TraceMethod::Bvh;
+    std::uint32_t resolution = 0; // as requested (0: the backend's default)
+    std::string device;           // the backend's device
+};
+
+// Resolves a request. Throws skybake::Error naming the field at fault:
+// "device" (unknown, or not the backend's), "backend" (unknown, or no
+// closest hits when they are needed), "method" (not the backend's) or
+// "resolution" (for a backend that takes none). The messages list the
+// registered choices. Does not probe the device: make_visibility_tracer()
+// fails when it is absent.
+TracerChoice resolve_tracer(const TracerRequest& request);
+
+// Create a backend's tracer or ray queries. Throw skybake::Error ("device"
+// or "backend") when it cannot run here: "cuda" in a build without CUDA or
+// on a machine without a CUDA device, "raster" without an OpenGL 4.3
+// context; ray queries of a backend without closest hits ("backend").
+std::unique_ptr<VisibilityTracer> make_visibility_tracer(const TracerChoice& choice);
+std::unique_ptr<RayQueries> make_ray_queries(const TracerChoice& choice);
+// The same by backend name, with a method and a resolution for the tracer.
 std::unique_ptr<RayQueries> make_ray_queries(const std::string& name);
 std::unique_ptr<VisibilityTracer> make_visibility_tracer(const std::string& name,
                                                          TraceMethod method = TraceMethod::Bvh,

@@ -31,11 +31,18 @@ def set_quiet(quiet: bool) -> None: ...
 
 class Backend:
     name: str
+    device: str
+    """Where it runs: 'cpu', 'cuda' or 'opengl'."""
+    summary: str
+    methods: list[str]
+    """Its methods, the default first."""
+    closest_hit: bool
+    """Whether it answers ray queries (bounces)."""
     available: bool
     problem: str
 
 def backends() -> list[Backend]:
-    """embree, brute, raster (and cuda in CUDA builds), each with whether it can run here."""
+    """The registered visibility backends (embree, cuda, raster, brute), each probed: whether it can run here."""
 
 class ProgressEvent:
     label: str
@@ -216,7 +223,7 @@ class BakeResult:
 def bake_ao(
     mesh: Mesh,
     rule: str = "lebedev:590",
-    backend: str = "embree",
+    backend: str = "",
     method: Optional[str] = None,
     resolution: int = 0,
     max_distance: float = ...,
@@ -225,6 +232,7 @@ def bake_ao(
     normalize: bool = False,
     store_bits: bool = False,
     progress: Progress = None,
+    device: str = "auto",
 ) -> BakeResult:
     """AO, shading coefficient and bent normals per vertex, also stored on the mesh. GIL released."""
 
@@ -262,11 +270,12 @@ def bake_transfer(
     model: str = "prt",
     bounces: int = 0,
     albedo: Optional[F32] = None,
-    backend: str = "embree",
+    backend: str = "",
     method: Optional[str] = None,
     resolution: int = 0,
     max_distance: float = ...,
     progress: Progress = None,
+    device: str = "auto",
 ) -> Transfer: ...
 
 class ShLight:

@@ -22,14 +22,21 @@ struct BakeResult {
 
 } // namespace
 
-// The tracer for a backend name and an optional method ("" or None: its
-// default). Shared with the PRT bindings.
-std::unique_ptr<VisibilityTracer> make_tracer(const std::string& backend, const std::optional<std::string>& method,
-                                              std::uint32_t resolution, TraceMethod* chosen) {
-    const TraceMethod m = method && !method->empty() ? parse_trace_method(*method) : default_trace_method(backend);
+// The tracer for a device, a backend name and an optional method ("" or
+// None: the backend's default), resolved by the library as for the CLI.
+// Shared with the PRT bindings.
+std::unique_ptr<VisibilityTracer> make_tracer(const std::string& device, const std::string& backend,
+                                              const std::optional<std::string>& method, std::uint32_t resolution,
+                                              TraceMethod* chosen) {
+    TracerRequest r;
+    r.device = device;
+    r.backend = backend;
+    r.method = method.value_or("");
+    r.resolution = resolution;
+    const TracerChoice c = resolve_tracer(r);
     if (chosen)
-        *chosen = m;
-    return make_visibility_tracer(backend, m, resolution);
+        *chosen = c.method;
+    return make_visibility_tracer(c);
 }
 
 BakeOptions bake_options(float max_distance, float offset, const std::string& back_faces, bool normalize) {
@@ -73,13 +80,13 @@ void bind_bake(py::module_& m) {
         "bake_ao",
         [](Mesh& mesh, const std::string& rule_spec, const std::string& backend, std::optional<std::string> method,
            std::uint32_t resolution, float max_distance, float offset, const std::string& back_faces, bool normalize,
-           bool store_bits, py::object progress) {
+           bool store_bits, py::object progress, const std::string& device) {
             const SphereRule rule = parse_rule(rule_spec);
             BakeOptions b = bake_options(max_distance, offset, back_faces, normalize);
             b.store_bits = store_bits;
             BakeOutputs out;
             AoBakeReport report = long_call(std::move(progress), [&] {
-                const auto tracer = make_tracer(backend, method, resolution, &b.method);
+                const auto tracer = make_tracer(device, backend, method, resolution, &b.method);
                 return bake_ambient_occlusion(mesh, rule, *tracer, b, &out);
             });
             BakeResult r;
@@ -93,15 +100,16 @@ void bind_bake(py::module_& m) {
             r.report = std::move(report);
             return r;
         },
-        py::arg("mesh"), py::arg("rule") = "lebedev:590", py::arg("backend") = "embree",
+        py::arg("mesh"), py::arg("rule") = "lebedev:590", py::arg("backend") = "",
         py::arg("method") = py::none(), py::arg("resolution") = 0u,
         py::arg("max_distance") = std::numeric_limits<float>::infinity(), py::arg("offset") = 0.0f,
         py::arg("back_faces") = "occlude", py::arg("normalize") = false, py::arg("store_bits") = false,
-        py::arg("progress") = py::none(),
+        py::arg("progress") = py::none(), py::arg("device") = "auto",
         "Bakes AO, the shading coefficient and bent normals at every vertex, as `skybake ao` does, and also "
         "stores them on the mesh (attributes 'ao', 'shading', 'bent_normal'; colours (AO, AO, AO, 1)); "
-        "normals are computed first when the mesh has none. backend: 'embree', 'brute', 'cuda' or 'raster' "
-        "(method 'cube' or 'directional', resolution in texels; 0: the default). The GIL is released; "
+        "normals are computed first when the mesh has none. device: 'auto' (a CUDA GPU when one answers, else "
+        "the CPU), 'cpu', 'cuda' or 'opengl'; backend: one of backends() ('': the device's first), e.g. "
+        "'raster' with method 'cube' or 'directional' and a resolution in texels (0: the default). The GIL is released; "
         "progress(event) is called at most every 100 ms; Ctrl-C or an exception it raises stops the bake.");
 
     m.def(

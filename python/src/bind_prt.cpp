@@ -11,8 +11,6 @@
 
 namespace skybake::python {
 
-std::unique_ptr<VisibilityTracer> make_tracer(const std::string& backend, const std::optional<std::string>& method,
-                                              std::uint32_t resolution, TraceMethod* chosen);
 BakeOptions bake_options(float max_distance, float offset, const std::string& back_faces, bool normalize);
 
 namespace {
@@ -68,7 +66,7 @@ void bind_prt(py::module_& m) {
         "bake_transfer",
         [](Mesh& mesh, const std::string& rule_spec, int order, const std::string& kind, const std::string& model,
            int bounces, const py::handle& albedo, const std::string& backend, std::optional<std::string> method,
-           std::uint32_t resolution, float max_distance, py::object progress) {
+           std::uint32_t resolution, float max_distance, py::object progress, const std::string& device) {
             const SphereRule rule = parse_rule(rule_spec);
             TransferOptions t;
             t.order = order;
@@ -79,18 +77,27 @@ void bind_prt(py::module_& m) {
             std::vector<glm::vec3> rho = albedo.is_none() ? mesh_albedo(mesh) : albedo_arg(albedo, mesh.vertex_count());
             Transfer out;
             long_call(std::move(progress), [&] {
-                const auto tracer = make_tracer(backend, method, resolution, &b.method);
+                TracerRequest request;
+                request.device = device;
+                request.backend = backend;
+                request.method = method.value_or("");
+                request.resolution = resolution;
+                request.closest_hit = t.kind == TransferKind::Interreflected;
+                const TracerChoice choice = resolve_tracer(request);
+                b.method = choice.method;
+                const auto tracer = make_visibility_tracer(choice);
                 std::unique_ptr<RayQueries> queries;
-                if (t.kind == TransferKind::Interreflected)
-                    queries = make_ray_queries(backend);
+                if (request.closest_hit)
+                    queries = make_ray_queries(choice);
                 bake_transfer(mesh, rule, *tracer, b, t, rho, queries.get(), out);
             });
             return out;
         },
         py::arg("mesh"), py::arg("rule") = "lebedev:590", py::arg("order") = 3, py::arg("kind") = "shadowed",
         py::arg("model") = "prt", py::arg("bounces") = 0, py::arg("albedo") = py::none(),
-        py::arg("backend") = "embree", py::arg("method") = py::none(), py::arg("resolution") = 0u,
+        py::arg("backend") = "", py::arg("method") = py::none(), py::arg("resolution") = 0u,
         py::arg("max_distance") = std::numeric_limits<float>::infinity(), py::arg("progress") = py::none(),
+        py::arg("device") = "auto",
         "The diffuse transfer of every vertex: kind 'unshadowed', 'shadowed' or 'interreflected' (bounces ≥ 1, "
         "a backend with ray queries); model 'prt' or 'shading-coefficient'. albedo (V, 3) float32 is used by the "
         "bounces (default: the vertex colours, else 0.8). Normals are computed when the mesh has none.");

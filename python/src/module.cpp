@@ -133,22 +133,23 @@ void LongCall::raise_keyboard_interrupt() {
 namespace {
 
 struct BackendInfo {
-    std::string name;
+    std::string name, device, summary;
+    std::vector<std::string> methods; // the default first
+    bool closest_hit = false;
     bool available = false;
     std::string problem; // why not available; empty if available
 };
 
+// The registered backends (skybake/visibility.h, [SECTION] Backends), each
+// probed: a GPU, an OpenGL context.
 std::vector<BackendInfo> backends() {
     std::vector<BackendInfo> out;
-    for (const std::string& name : visibility_backend_names()) {
-        BackendInfo info{name, true, {}};
-        try {
-            if (name == "cuda" || name == "raster")
-                make_visibility_tracer(name, default_trace_method(name)); // a GPU, an OpenGL context
-        } catch (const Error& e) {
-            info.available = false;
-            info.problem = e.message();
-        }
+    for (const TracerBackend& b : tracer_backends()) {
+        BackendInfo info{b.name, b.device, b.summary, {}, b.closest_hit, true, {}};
+        for (TraceMethod m : b.methods)
+            info.methods.push_back(trace_method_name(m));
+        info.problem = b.problem ? b.problem() : std::string();
+        info.available = info.problem.empty();
         out.push_back(std::move(info));
     }
     return out;
@@ -209,6 +210,10 @@ void bind_core(py::module_& m) {
 
     py::class_<BackendInfo>(m, "Backend", "A visibility backend of this build and whether it can run here.")
         .def_readonly("name", &BackendInfo::name)
+        .def_readonly("device", &BackendInfo::device, "Where it runs: 'cpu', 'cuda' or 'opengl'.")
+        .def_readonly("summary", &BackendInfo::summary)
+        .def_readonly("methods", &BackendInfo::methods, "Its methods, the default first.")
+        .def_readonly("closest_hit", &BackendInfo::closest_hit, "Whether it answers ray queries (bounces).")
         .def_readonly("available", &BackendInfo::available)
         .def_readonly("problem", &BackendInfo::problem, "Why it cannot run here; empty if it can.")
         .def("__repr__", [](const BackendInfo& b) {

@@ -1,6 +1,7 @@
-// The visibility backends' factories and names, and the generic tracer on top
-// of RayQueries::occluded() (used by the brute-force oracle; the Embree and
-// CUDA backends have their own loops).
+// The names of the back-face modes and trace methods, and the generic tracer
+// on top of RayQueries::occluded() (used by the brute-force oracle; the
+// Embree and CUDA backends have their own loops). The backends themselves
+// are registered in registry.cpp.
 #include <algorithm>
 
 #include <fmt/format.h>
@@ -8,11 +9,7 @@
 #include "core/parallel.h"
 #include "skybake/error.h"
 #include "skybake/names.h"
-#include "visibility/brute_backend.h"
-#include "visibility/cuda/cuda_backend.h"
-#include "visibility/embree/embree_backend.h"
 #include "visibility/query_tracer.h"
-#include "visibility/raster/raster_tracer.h"
 #include "visibility/trace_hd.h"
 
 namespace skybake {
@@ -32,23 +29,6 @@ constexpr NamedValue<TraceMethod> kTraceMethodNames[] = {
     {TraceMethod::Directional, "directional", "raster backend: a depth map per direction"},
 };
 
-const char* method_owner(TraceMethod method) {
-    return method == TraceMethod::Cube || method == TraceMethod::Directional ? "raster" : "cuda";
-}
-
-void require_bvh(TraceMethod method, const char* backend) {
-    if (method != TraceMethod::Bvh)
-        throw Error(fmt::format("the {} method is the {} backend's; the {} backend has only bvh",
-                                trace_method_name(method), method_owner(method), backend),
-                    "method");
-}
-
-void require_no_resolution(std::uint32_t resolution, const char* backend) {
-    if (resolution != 0)
-        throw Error(fmt::format("a resolution is for the raster backend; the {} backend traces rays", backend),
-                    "resolution");
-}
-
 } // namespace
 
 const char* back_faces_name(BackFaces mode) { return name_of(kBackFacesNames, mode); }
@@ -61,70 +41,6 @@ const char* trace_method_name(TraceMethod method) { return name_of(kTraceMethodN
 
 TraceMethod parse_trace_method(const std::string& text) {
     return parse_name(kTraceMethodNames, text, "method", "method");
-}
-
-TraceMethod default_trace_method(const std::string& backend) {
-    return backend == "raster" ? TraceMethod::Cube : TraceMethod::Bvh;
-}
-
-std::vector<std::string> visibility_backend_names() {
-#if defined(SKYBAKE_HAS_CUDA)
-    return {"embree", "brute", "cuda", "raster"};
-#else
-    return {"embree", "brute", "raster"};
-#endif
-}
-
-[[noreturn]] static void unknown_backend(const std::string& name) {
-    throw Error(fmt::format("unknown visibility backend '{}'; choose embree (default), cuda (NVIDIA GPUs), raster "
-                            "(the depth buffer of OpenGL) or brute (a test oracle for small meshes)",
-                            name),
-                "backend");
-}
-
-std::unique_ptr<RayQueries> make_ray_queries(const std::string& name) {
-    if (name == "embree")
-        return std::make_unique<visibility::EmbreeBackend>();
-    if (name == "brute")
-        return std::make_unique<visibility::BruteForceBackend>();
-    if (name == "cuda")
-        return visibility::make_cuda_ray_queries(); // throws without CUDA or a device
-    if (name == "raster")
-        throw Error("the raster backend answers no single ray queries (it bakes visibility with the depth buffer); "
-                    "use embree or cuda",
-                    "backend");
-    unknown_backend(name);
-}
-
-std::unique_ptr<VisibilityTracer> make_visibility_tracer(const std::string& name, TraceMethod method,
-                                                         std::uint32_t resolution) {
-    if (name == "embree") {
-        require_bvh(method, "embree");
-        require_no_resolution(resolution, "embree");
-        return std::make_unique<visibility::EmbreeBackend>();
-    }
-    if (name == "brute") {
-        require_bvh(method, "brute");
-        require_no_resolution(resolution, "brute");
-        return std::make_unique<visibility::BruteForceBackend>();
-    }
-    if (name == "cuda") {
-        if (method == TraceMethod::Cube || method == TraceMethod::Directional)
-            throw Error(fmt::format("the {} method is the raster backend's; the cuda backend has bvh, per-vertex "
-                                    "and per-polygon",
-                                    trace_method_name(method)),
-                        "method");
-        require_no_resolution(resolution, "cuda");
-        return visibility::make_cuda_tracer(method); // throws without CUDA or a device
-    }
-    if (name == "raster") {
-        if (method != TraceMethod::Cube && method != TraceMethod::Directional)
-            throw Error(fmt::format("the raster backend has the methods cube (default) and directional, not {}",
-                                    trace_method_name(method)),
-                        "method");
-        return std::make_unique<visibility::RasterTracer>(method, resolution); // throws without OpenGL 4.3
-    }
-    unknown_backend(name);
 }
 
 namespace visibility {

@@ -91,16 +91,18 @@ def get():
 
 
 def backends():
-    """[(name, available, problem)] of the module's visibility backends, probed once; [] without the module."""
+    """[(name, available, problem, summary)] of the module's registered visibility backends, probed once;
+    [] without the module."""
     global _backends
     sb = get()
     if sb is None:
         return []
     if _backends is None:
         try:
-            _backends = [(b.name, b.available, b.problem) for b in sb.backends()]
+            _backends = [(b.name, b.available, b.problem, f"{b.summary} (on {b.device})")
+                         for b in sb.backends()]
         except Exception as e:
-            _backends = [("embree", True, ""), ("_error", False, str(e))]
+            _backends = [("embree", True, "", ""), ("_error", False, str(e), "")]
     return _backends
 
 

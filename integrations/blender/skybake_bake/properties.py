@@ -25,8 +25,8 @@ _backend_items = []  # Blender keeps pointers into the strings: hold them here
 
 
 def backend_items(self, context):
-    items = [(name, name, f"skybake visibility backend '{name}'")
-             for name, available, _ in module_loader.backends() if available]
+    items = [(name, name, summary or f"skybake visibility backend '{name}'")
+             for name, available, _, summary in module_loader.backends() if available]
     if not items:
         items = [("embree", "embree", "skybake visibility backend 'embree'")]
     _backend_items[:] = items

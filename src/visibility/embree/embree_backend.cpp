@@ -360,3 +360,17 @@ void EmbreeBackend::trace(const TraceChunk& chunk) {
 }
 
 } // namespace skybake::visibility
+
+// Registered first: the CPU's default backend (skybake/visibility.h, [SECTION] Backends).
+void skybake_register_embree_tracer() {
+    using namespace skybake;
+    TracerBackend b;
+    b.name = "embree";
+    b.device = "cpu";
+    b.summary = "Intel Embree 3 on the CPU, every core (the CPU's default)";
+    b.methods = {TraceMethod::Bvh};
+    b.closest_hit = true;
+    b.make_tracer = [](TraceMethod, std::uint32_t) { return std::make_unique<visibility::EmbreeBackend>(); };
+    b.make_ray_queries = [] { return std::make_unique<visibility::EmbreeBackend>(); };
+    register_tracer_backend(std::move(b));
+}

@@ -534,3 +534,25 @@ void RasterTracer::trace_directional(const TraceChunk& chunk) {
 }
 
 } // namespace skybake::visibility
+
+void skybake_register_raster_tracer() {
+    using namespace skybake;
+    TracerBackend b;
+    b.name = "raster";
+    b.device = "opengl";
+    b.summary = "the depth buffer of any OpenGL 4.3 context (a GPU, or Mesa's llvmpipe)";
+    b.methods = {TraceMethod::Cube, TraceMethod::Directional};
+    b.resolution = true;
+    b.make_tracer = [](TraceMethod method, std::uint32_t resolution) {
+        return std::make_unique<visibility::RasterTracer>(method, resolution);
+    };
+    b.problem = [] {
+        try {
+            visibility::RasterTracer probe(TraceMethod::Cube, 0); // opens a context
+            return std::string();
+        } catch (const Error& e) {
+            return e.message();
+        }
+    };
+    register_tracer_backend(std::move(b));
+}

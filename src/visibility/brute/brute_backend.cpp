@@ -1,7 +1,7 @@
 // Brute-force visibility: every ray against every triangle (the "naive method"
 // of seed 002), in double precision with the Möller–Trumbore test. Kept only
 // as an independent oracle for the tests of the fast backends.
-#include "visibility/brute_backend.h"
+#include "visibility/brute/brute_backend.h"
 
 #include <cassert>
 
@@ -82,3 +82,16 @@ std::uint32_t BruteForceBackend::set_rule(const TraceRule& rule) {
 void BruteForceBackend::trace(const TraceChunk& chunk) { trace_with_queries(*this, rule_, chunk); }
 
 } // namespace skybake::visibility
+
+void skybake_register_brute_tracer() {
+    using namespace skybake;
+    TracerBackend b;
+    b.name = "brute";
+    b.device = "cpu";
+    b.summary = "every ray against every triangle in double precision: a test oracle for small meshes";
+    b.methods = {TraceMethod::Bvh};
+    b.closest_hit = true;
+    b.make_tracer = [](TraceMethod, std::uint32_t) { return std::make_unique<visibility::BruteForceBackend>(); };
+    b.make_ray_queries = [] { return std::make_unique<visibility::BruteForceBackend>(); };
+    register_tracer_backend(std::move(b));
+}
