@@ -6,12 +6,18 @@
 //   both alike). Counters: vertices/s and texels/s of the trace phase (rays
 //   and reduction, not the BVH), the texel sampling time of the UV layout, and
 //   the ratio texels/s ÷ vertices/s (both are points of the same driver).
+// BM_TexturePreviewBake: what `ao --texture 1024 --preview` computes on the
+//   same terrain, the way the command did it before the bake job (one
+//   tracer whose structure the texture pass and the vertex pass each built,
+//   and the preview's own Embree scene: 3 builds) against run_bake_job()
+//   (1 build), alternately within each iteration. Counters: seconds of each.
 #include <algorithm>
 #include <chrono>
 
 #include <benchmark/benchmark.h>
 
 #include "skybake/bake.h"
+#include "skybake/bake_job.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 #include "skybake/texture_bake.h"
@@ -59,6 +65,49 @@ void BM_TextureVsVertexBake(benchmark::State& state) {
     state.counters["ratio_texels_to_vertices"] = tps / vps;
 }
 BENCHMARK(BM_TextureVsVertexBake)->Arg(2048)->Iterations(2)->Unit(benchmark::kSecond)->UseRealTime();
+
+void BM_TexturePreviewBake(benchmark::State& state) {
+    const Mesh input = terrain();
+    const SphereRule rule = parse_rule("lebedev:50");
+    TextureBakeOptions texture;
+    texture.texture_size = 1024;
+    AoPreviewOptions preview; // 960 x 720, as the command's default
+    double before = 0.0, after = 0.0;
+    int builds = 0;
+    for (auto _ : state) {
+        using clock = std::chrono::steady_clock;
+        {
+            Mesh mesh = input;
+            compute_normals(mesh);
+            const auto t0 = clock::now();
+            const auto tracer = make_visibility_tracer("embree");
+            const AoTexture t = bake_ao_texture(mesh, rule, *tracer, {}, texture);
+            bake_ambient_occlusion(mesh, rule, *tracer, {});
+            const Image img = render_texture_preview(mesh, t, 0, {}, preview);
+            before += std::chrono::duration<double>(clock::now() - t0).count();
+            benchmark::DoNotOptimize(img.rgb.data());
+        }
+        {
+            Mesh mesh = input;
+            compute_normals(mesh);
+            const auto t0 = clock::now();
+            BakeJob job;
+            job.rule = rule;
+            job.tracer.device = "cpu";
+            job.texture = texture;
+            job.preview = preview;
+            const BakeJobResult r = run_bake_job(mesh, job);
+            after += std::chrono::duration<double>(clock::now() - t0).count();
+            builds = r.acceleration_structures;
+            benchmark::DoNotOptimize(r.preview.rgb.data());
+        }
+    }
+    const double it = double(state.iterations());
+    state.counters["separate_s"] = before / it;
+    state.counters["job_s"] = after / it;
+    state.counters["job_builds"] = builds;
+}
+BENCHMARK(BM_TexturePreviewBake)->Iterations(2)->Unit(benchmark::kSecond)->UseRealTime();
 
 } // namespace
 

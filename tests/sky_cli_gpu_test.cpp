@@ -51,7 +51,7 @@ TEST(GpuSkyCli, NoDeviceIsOneLineAndNoOutput) {
         const auto r = run_cli(args);
         EXPECT_EQ(r.exit_code, 1) << r.err;
         EXPECT_EQ(r.err_lines(), 1) << r.err;
-        EXPECT_NE(r.err.find("--device cuda"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("--device"), std::string::npos) << r.err;
     }
     // Only the input is left in the folder.
     EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 1);

@@ -36,7 +36,7 @@ def closure(name, seen=None):
 
 allowed = {m: closure(m) | {m} for m in direct}
 # The public header each module owns (include/skybake/NAME.h).
-owner = {"bake.h": "bake", "visibility.h": "visibility", "sky.h": "sky", "neural.h": "neural",
+owner = {"bake.h": "bake", "bake_job.h": "job", "visibility.h": "visibility", "sky.h": "sky", "neural.h": "neural",
          "sphere.h": "sphere", "mesh.h": "io", "image.h": "io", "gltf_asset.h": "io", "sh.h": "sphere", "texture_bake.h": "bake", "distributed.h": "distributed",
          "sky_source.h": "neural", "planet.h": "planet", "render.h": "render", "prt.h": "prt",
          "viewer.h": "render"}

@@ -21,10 +21,12 @@
 #include "job.h"
 #include "skybake/files.h"
 #include "skybake/bake.h"
+#include "skybake/bake_job.h"
 #include "skybake/core.h"
 #include "skybake/gltf_asset.h"
 #include "skybake/interrupt.h"
 #include "skybake/mesh.h"
+#include "skybake/prt.h"
 #include "skybake/sphere.h"
 #include "skybake/texture_bake.h"
 #include "skybake/visibility.h"
@@ -119,21 +121,13 @@ TracerChoice tracer_choice(const AoOptions& o) {
 void run(const AoOptions& o, const CLI::App& sub, bool job) {
     // Everything that can be checked without the mesh is checked first, so a
     // typo fails at once and no output file is started.
-    const SphereRule rule = parse_flag("--rule", [&] { return parse_rule(o.rule); });
-    if (rule.kind == RuleKind::Phong)
-        throw UsageError(fmt::format("'{}' integrates against a Phong lobe, not over the sphere; use a lebedev, "
-                                     "design, fibonacci or mc rule for ambient occlusion",
-                                     rule.spec),
-                         "--rule");
-    const TracerChoice choice = tracer_choice(o);
-    const TraceMethod method = choice.method;
-    if (method == TraceMethod::Directional && std::isfinite(o.max_distance))
-        throw UsageError("the directional method has no maximum distance; use --method cube", "--max-distance");
-    if (method == TraceMethod::Directional && rule.rotate_per_vertex)
-        throw UsageError(fmt::format("the directional method needs one set of directions for every vertex; drop "
-                                     "+rotate from '{}', or use --method cube",
-                                     rule.spec),
-                         "--rule");
+    BakeJob bake;
+    bake.rule = parse_flag("--rule", [&] { return parse_rule(o.rule); });
+    bake.tracer.device = o.device;
+    bake.tracer.backend = o.backend;
+    bake.tracer.method = o.method;
+    bake.tracer.resolution = o.resolution;
+    bake.options.max_distance = float(o.max_distance);
     const BackFaces back_faces = parse_flag("--back-faces", [&] { return parse_back_faces(o.back_faces); });
     AoPreviewOptions preview;
     parse_flag("--preview-size", [&] { parse_size(o.preview_size, preview.width, preview.height, "--preview-size"); });
@@ -157,51 +151,46 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
             throw UsageError("a texture bake is wired into a glTF material; write the mesh as .glb or .gltf",
                              "--output");
     }
-    // no GPU or GL: exit 1; in a job, each rank traces with its own
-    const auto tracer = job_tracer(make_visibility_tracer(choice), job);
+    BakeOptions& b = bake.options;
+    b.ray_offset = o.offset == "auto" ? 0.0f : float(std::stod(o.offset)); // validated: auto or a number ≥ 0
+    b.back_faces = back_faces;
+    b.normalize = o.normalize;
+    bake.bits = !o.bits.empty();
+    if (o.texture != 0) {
+        bake.texture.emplace();
+        bake.texture->texture_size = o.texture;
+        bake.texture->uv_set = o.uv;
+        bake.texture->dilate_texels = o.dilate;
+        bake.texture->stitch_seams = !o.keep_seams;
+    }
+    if (!o.preview.empty() && (!job || job_root()))
+        bake.preview = preview;
+    if (job) // each rank traces its share with its own backend
+        bake.wrap_tracer = [](std::unique_ptr<VisibilityTracer> local) { return job_tracer(std::move(local), true); };
+    const TracerChoice choice = parse_flags([&] { return check_bake_job(bake); });
+    bake.made_tracer = make_visibility_tracer(choice); // no GPU or GL: exit 1, before the mesh is read
+    const TraceMethod method = choice.method;
     const std::uint32_t resolution = !choice.backend->resolution  ? 0
                                      : o.resolution                ? o.resolution
                                      : method == TraceMethod::Cube ? kRasterCubeResolution
                                                                    : kRasterDirectionalResolution;
 
-    BakeOptions b;
-    b.max_distance = float(o.max_distance);
-    b.ray_offset = o.offset == "auto" ? 0.0f : float(std::stod(o.offset)); // validated: auto or a number ≥ 0
-    b.back_faces = back_faces;
-    b.normalize = o.normalize;
-    b.store_bits = !o.bits.empty();
-    b.method = method;
-
     // A glTF 2.0 input written as glTF is baked in place: the output is the
     // input document with the new attributes (skybake/gltf_asset.h).
-    const bool gltf_out = lower_extension(o.output) != ".ply";
-    std::optional<GltfAsset> asset;
-    if (gltf_out && GltfAsset::is_gltf2(o.input))
-        asset = GltfAsset::load(o.input);
-    else if (lower_extension(o.output) == ".gltf")
-        throw UsageError("a .gltf output keeps a glTF 2.0 input's document; write other inputs as .glb", "--output");
-    Mesh plain = asset ? Mesh() : load_model(o.input);
-    Mesh& mesh = asset ? asset->mesh() : plain;
+    BakeFile file = open_bake_file(o.input, o.output);
+    GltfAsset* asset = file.document();
+    Mesh& mesh = file.mesh();
     test_fault_point("load");
-    // The texture bake first: its checks of the UV layout and the size come
-    // before any long work.
-    std::optional<AoTexture> texture;
-    TextureBakeOptions tb;
-    if (o.texture != 0) {
-        tb.texture_size = o.texture;
-        tb.uv_set = o.uv;
-        tb.dilate_texels = o.dilate;
-        tb.stitch_seams = !o.keep_seams;
-        if (mesh.normals.empty())
-            compute_normals(mesh);
-        texture = bake_ao_texture(mesh, rule, *tracer, b, tb);
-        if (texture->overlapping_texels > 0)
-            info("warning: UV set {} overlaps: {} texel centres lie in two or more triangles ({} triangles); "
-                 "the nearest triangle in mesh order wins there",
-                 o.uv, texture->overlapping_texels, texture->overlapping_triangles);
-    }
-    BakeOutputs outputs;
-    const AoBakeReport r = bake_ambient_occlusion(mesh, rule, *tracer, b, &outputs);
+    if (bake.texture && bake.preview)
+        bake.base_colors = base_color_images(mesh); // the texture shown over them, where they load
+    BakeJobResult result = run_bake_job(mesh, bake);
+    const AoBakeReport& r = result.ao;
+    const BakeOutputs& outputs = result.outputs;
+    const std::optional<AoTexture>& texture = result.texture;
+    if (texture && texture->overlapping_texels > 0)
+        info("warning: UV set {} overlaps: {} texel centres lie in two or more triangles ({} triangles); "
+             "the nearest triangle in mesh order wins there",
+             o.uv, texture->overlapping_texels, texture->overlapping_triangles);
     if (texture) {
         if (asset)
             asset->set_occlusion_texture(texture_out, o.uv);
@@ -215,31 +204,11 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
     // Every output is staged, then all are committed together: a failure in
     // any one of them leaves none written.
     OutputSet files;
-    if (asset)
-        asset->save(files.stage(o.output));
-    else
-        save_mesh(files.stage(o.output), mesh);
-    if (!o.preview.empty() && texture) {
-        // The texture on the model, over its base colour images where they load.
-        std::vector<Image> base_colors(mesh.materials.size());
-        for (std::size_t m = 0; m < mesh.materials.size(); ++m) {
-            std::error_code ec;
-            const MeshMaterial& mm = mesh.materials[m];
-            const std::string& image = mm.base_color_texture;
-            if (!mm.base_color_image.empty())
-                base_colors[m] = load_image_from_memory(mm.base_color_image.data(), mm.base_color_image.size(),
-                                                        mm.base_color_image_type == "image/jpeg" ? "jpg" : "png",
-                                                        o.input);
-            else if (!image.empty() && std::filesystem::is_regular_file(image, ec))
-                base_colors[m] = load_image(image);
-        }
-        save_image(files.stage(o.preview), render_texture_preview(mesh, *texture, o.uv, base_colors, preview),
-                   ToneMap{0.0f, ToneCurve::Clamp});
-    } else if (!o.preview.empty()) {
-        save_image(files.stage(o.preview), render_ao_preview(mesh, preview), ToneMap{0.0f, ToneCurve::Clamp});
-    }
+    file.save(files.stage(o.output));
+    if (!o.preview.empty())
+        save_image(files.stage(o.preview), result.preview, ToneMap{0.0f, ToneCurve::Clamp});
     if (!o.bits.empty())
-        save_visibility_bits(files.stage(o.bits), outputs, rule);
+        save_visibility_bits(files.stage(o.bits), outputs, bake.rule);
     if (texture) {
         const int n = texture->texture_size;
         if (lower_extension(texture_out) == ".exr") {
@@ -253,7 +222,7 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
     }
     files.commit();
 
-    const std::string device = tracer->device_name();
+    const std::string device = result.device_name;
     if (o.json) {
         nlohmann::json j = {{"input", o.input},
                             {"output", o.output},
@@ -281,7 +250,8 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
                             {"shading", stats(outputs.shading)},
                             {"preview", o.preview.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.preview)},
                             {"bits", o.bits.empty() ? nlohmann::json(nullptr) : nlohmann::json(o.bits)},
-                            {"threads", thread_count()}};
+                            {"threads", thread_count()},
+                            {"acceleration_structures", result.acceleration_structures}};
         if (job) {
             const DistributedStats d = last_distributed_stats();
             j["ranks"] = d.ranks;

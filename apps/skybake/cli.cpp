@@ -1,5 +1,9 @@
 #include "cli.h"
 
+#include <optional>
+
+#include "flags.h"
+
 #include <charconv>
 
 namespace skybake::cli {
@@ -9,6 +13,19 @@ Mesh load_model(const std::string& path) {
     Mesh mesh = load_mesh(path, &report);
     warn_missing_textures(path, report);
     return mesh;
+}
+
+BakeFile open_bake_file(const std::string& input, const std::string& output) {
+    std::optional<BakeFile> f;
+    try {
+        f.emplace(BakeFile::open(input, output));
+    } catch (const Error& e) {
+        if (e.where() == "output")
+            throw UsageError(e.message(), "--output");
+        throw;
+    }
+    warn_missing_textures(input, f->report());
+    return std::move(*f);
 }
 
 void warn_missing_textures(const std::string& path, const ImportReport& report) {

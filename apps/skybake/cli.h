@@ -15,6 +15,7 @@
 
 #include "skybake/core.h"
 #include "skybake/error.h"
+#include "skybake/gltf_asset.h"
 #include "skybake/mesh.h"
 
 namespace skybake::cli {
@@ -37,6 +38,10 @@ void info(fmt::format_string<Args...> f, Args&&... args) {
 // load_mesh(), with a warning line for each texture the model names that was
 // not found (the material keeps its colour): every command that reads a model.
 Mesh load_model(const std::string& path);
+// The mesh of a bake that writes `output` (skybake/gltf_asset.h, BakeFile): a
+// glTF 2.0 input keeps its document; warns of missing textures as
+// load_model() does. A .gltf output of another input is a UsageError.
+BakeFile open_bake_file(const std::string& input, const std::string& output);
 // The warning lines of load_model(), for a report from elsewhere.
 void warn_missing_textures(const std::string& path, const ImportReport& report);
 

@@ -250,7 +250,7 @@ std::string backend_help() {
         std::string methods;
         for (TraceMethod m : b.methods)
             methods += std::string(methods.empty() ? "" : ", ") + trace_method_name(m);
-        text += fmt::format(" {} ({}; on {}; methods {})", b.name, b.summary, b.device, methods);
+        text += fmt::format(" {} [on {}; methods {}]: {}", b.name, b.device, methods, b.summary);
         text += &b == &tracer_backends().back() ? "." : ";";
     }
     return text;

@@ -18,24 +18,13 @@ void run(const MeshConvertOptions& o) {
     check_output_path(o.output, {".glb", ".gltf", ".ply"}, "--output");
     if (o.ascii && lower_extension(o.output) != ".ply")
         throw UsageError("--ascii applies to .ply outputs only", "--ascii");
-    ImportReport rep;
-    Mesh mesh;
-    if (lower_extension(o.output) != ".ply" && GltfAsset::is_gltf2(o.input)) {
-        // glTF 2.0 to glTF: the document is kept whole (skybake/gltf_asset.h).
-        const GltfAsset asset = GltfAsset::load(o.input);
-        asset.save(o.output);
-        mesh = asset.mesh();
-        rep = asset.report();
-    } else {
-        if (lower_extension(o.output) == ".gltf")
-            throw UsageError("a .gltf output keeps a glTF 2.0 input's document; write other inputs as .glb",
-                             "--output");
-        mesh = load_mesh(o.input, &rep);
-        warn_missing_textures(o.input, rep);
-        ExportOptions e;
-        e.ply_encoding = o.ascii ? PlyEncoding::Ascii : PlyEncoding::Binary;
-        save_mesh(o.output, mesh, e);
-    }
+    // glTF 2.0 to glTF keeps the document whole, as the bakes do (skybake/gltf_asset.h).
+    const BakeFile file = open_bake_file(o.input, o.output);
+    ExportOptions e;
+    e.ply_encoding = o.ascii ? PlyEncoding::Ascii : PlyEncoding::Binary;
+    file.save(o.output, e);
+    const Mesh& mesh = file.mesh();
+    const ImportReport& rep = file.report();
     if (o.json) {
         print_json({{"input", o.input},
                     {"output", o.output},

@@ -1,4 +1,4 @@
-// skybake prt bake INPUT -o OUTPUT.glb|.ply [--order L] [--kind K] [--bounces N] [--rule R] [--backend B]
+// skybake prt bake INPUT -o OUTPUT.glb|.gltf|.ply [--order L] [--kind K] [--bounces N] [--rule R] [--backend B]
 //                  [--device D] [--method M] [--resolution N] [--albedo A] [--model prt|shading-coefficient] [--max-distance D] [--json]
 // Per-vertex diffuse SH transfer (skybake/prt.h), with a JSON sidecar.
 // Under mpirun (or with --mpi) the visibility is spread over the ranks (job.h).
@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "flags.h"
 #include "job.h"
+#include "skybake/bake_job.h"
 #include "skybake/files.h"
 #include "skybake/mesh.h"
 #include "skybake/prt.h"
@@ -55,12 +56,9 @@ glm::vec3 parse_albedo(const std::string& text) {
 
 void run(const BakeOpts& o, const CLI::App& sub) {
     const bool job = start_job(o.mpi); // first: in a job, every error is reported once
-    const SphereRule rule = parse_flag("--rule", [&] { return parse_rule(o.rule); });
-    if (rule.kind == RuleKind::Phong)
-        throw UsageError(fmt::format("'{}' integrates against a Phong lobe, not over the sphere; use a lebedev, "
-                                     "design, fibonacci or mc rule for a transfer bake",
-                                     rule.spec),
-                         "--rule");
+    BakeJob bake;
+    bake.rule = parse_flag("--rule", [&] { return parse_rule(o.rule); });
+    bake.shading = false;
     TransferOptions t;
     t.order = o.order;
     t.bounces = o.bounces;
@@ -74,49 +72,51 @@ void run(const BakeOpts& o, const CLI::App& sub) {
     t.model = parse_flag("--model", [&] { return parse_transfer_model(o.model); });
     if (t.model == TransferModel::ShadingCoefficient && o.bounces > 0)
         throw UsageError("the shading-coefficient model has no bounces", "--bounces");
-    TracerRequest request;
-    request.device = o.device;
-    request.backend = o.backend;
-    request.method = o.method;
-    request.resolution = o.resolution;
-    request.closest_hit = t.kind == TransferKind::Interreflected; // the bounces' gathers
-    const TracerChoice choice = parse_flags([&] { return resolve_tracer(request); });
-    const bool constant_albedo = !o.albedo.empty();
+    bake.tracer.device = o.device;
+    bake.tracer.backend = o.backend;
+    bake.tracer.method = o.method;
+    bake.tracer.resolution = o.resolution;
+    bake.options.max_distance = float(o.max_distance);
+    bake.transfer = t;
+    const TracerChoice choice = parse_flags([&] { return check_bake_job(bake); }); // every rank, before any work
+    bake.made_tracer = make_visibility_tracer(choice); // no GPU or GL: exit 1, before the mesh is read
+    const bool constant_albedo = !o.albedo.empty() && o.albedo != "material";
     const glm::vec3 albedo_value = constant_albedo ? parse_albedo(o.albedo) : glm::vec3(0.8f);
-    check_output_path(o.output, {".glb", ".ply"}, "--output");
-    const auto tracer = job_tracer(make_visibility_tracer(choice), job);
-    std::unique_ptr<RayQueries> queries;
-    if (t.kind == TransferKind::Interreflected)
-        queries = make_ray_queries(choice);
-    if (job && !job_root() && t.kind == TransferKind::Interreflected) {
-        // The bounces run on rank 0, over the gathered words; the other ranks
-        // only trace visibility, which the shadowed bake shares.
-        t.kind = TransferKind::Shadowed;
-        t.bounces = 0;
-        queries.reset();
+    check_output_path(o.output, {".glb", ".gltf", ".ply"}, "--output");
+    if (job) {
+        bake.wrap_tracer = [](std::unique_ptr<VisibilityTracer> local) { return job_tracer(std::move(local), true); };
+        if (!job_root() && t.kind == TransferKind::Interreflected) {
+            // The bounces run on rank 0, over the gathered words; the other
+            // ranks only trace visibility, which the shadowed bake shares.
+            bake.transfer->kind = TransferKind::Shadowed;
+            bake.transfer->bounces = 0;
+        }
     }
 
-    Mesh mesh = load_model(o.input);
+    // A glTF 2.0 input keeps its document, as with `ao` (skybake/gltf_asset.h).
+    BakeFile file = open_bake_file(o.input, o.output);
+    Mesh& mesh = file.mesh();
+    const bool had_colors = mesh.colors.size() == mesh.vertex_count();
     test_fault_point("load");
-    const std::vector<glm::vec3> albedo =
+    bake.albedo =
         constant_albedo ? std::vector<glm::vec3>(mesh.vertex_count(), albedo_value) : mesh_albedo(mesh, albedo_value);
     const std::string albedo_source =
         constant_albedo ? fmt::format("[{}, {}, {}]", albedo_value.x, albedo_value.y, albedo_value.z)
                         : !mesh.materials.empty() && !mesh.triangle_parts.empty()
                             ? "material"
                             : (mesh.colors.size() == mesh.vertex_count() ? "vertex-colors" : "[0.8, 0.8, 0.8]");
-    BakeOptions b;
-    b.max_distance = float(o.max_distance);
-    b.method = tracer->method();
-    Transfer transfer;
-    const TransferReport r = bake_transfer(mesh, rule, *tracer, b, t, albedo, queries.get(), transfer);
+    const BakeJobResult result = run_bake_job(mesh, bake);
+    const TransferReport& r = result.transfer_report;
+    const Transfer& transfer = result.transfer;
     if (job && !job_root())
         return; // rank 0 alone has the results, and writes them
-    set_transfer_attributes(mesh, transfer, albedo);
+    set_transfer_attributes(mesh, transfer, bake.albedo);
+    if (!had_colors)
+        set_white_sky_colors(mesh, transfer); // COLOR_0, as `ao` writes it, for any viewer
 
     OutputSet files;
-    save_mesh(files.stage(o.output), mesh);
-    const std::string side = transfer_sidecar_json(transfer, mesh.vertex_count(), albedo_source);
+    file.save(files.stage(o.output));
+    const std::string side = transfer_sidecar_json(transfer, mesh.vertex_count(), albedo_source, !had_colors);
     write_stream_atomic(files.stage(prt_sidecar_path(o.output)), [&](std::ostream& out) { out << side; });
     files.commit();
 
@@ -138,7 +138,9 @@ void run(const BakeOpts& o, const CLI::App& sub) {
                     {"bounce_rays", r.bounce_rays},
                     {"seconds", r.seconds},
                     {"trace_seconds", r.trace_seconds},
-                    {"bounce_seconds", r.bounce_seconds}});
+                    {"bounce_seconds", r.bounce_seconds},
+                    {"device", result.choice.device},
+                    {"acceleration_structures", result.acceleration_structures}});
         return;
     }
     info("baked {} transfer (order {}, {} coefficients{}) of {} vertices with {} on {}: {} rays{} in {:.2f} s; "
@@ -156,8 +158,9 @@ void add_prt_bake(CLI::App& group) {
     auto* sub = group.add_subcommand("bake", "Bake per-vertex diffuse SH transfer vectors (PRT)");
     sub->add_option("input", o->input, "Input mesh (any format 'mesh info' reads)")->required();
     sub->add_option("-o,--output", o->output,
-                    "Output mesh (.glb or .ply) with attributes prt_0... and albedo; a sidecar OUTPUT.prt.json "
-                    "beside it")
+                    "Output mesh (.glb, .gltf or .ply) with attributes prt_0..., albedo and COLOR_0 (the vertex "
+                    "under a white sky, AO for a shadowed transfer, unless the input has colours); a glTF 2.0 "
+                    "input keeps its whole document; a sidecar OUTPUT.prt.json beside it")
         ->required();
     sub->add_option("--order", o->order, "Highest SH band l (coefficients: (l+1)^2)")
         ->check(integer_in(0, kPrtMaxOrder))
@@ -175,8 +178,9 @@ void add_prt_bake(CLI::App& group) {
     sub->add_option("--resolution", o->resolution, "raster: cube face or depth map size in texels")
         ->check(CLI::Range(8u, kRasterMaxResolution));
     sub->add_option("--albedo", o->albedo,
-                    "Linear RGB albedo, one or three numbers in [0, 1] (default: the material's base colour factor x image x "
-                    "vertex colour, as glTF defines it; else the vertex colours; else 0.8)");
+                    "The bounces' albedo: material (the default: the material's base colour factor x image x vertex "
+                    "colour, as glTF defines it, at each vertex; else the vertex colours; else 0.8), or a constant "
+                    "linear RGB reflectance, one or three numbers in [0, 1]");
     sub->add_option("--model", o->model,
                     "prt (the transfer integral) or shading-coefficient (the seed's A times the unshadowed "
                     "irradiance)")

@@ -14,6 +14,7 @@
 #include "commands.h"
 #include "flags.h"
 #include "sky_common.h"
+#include "skybake/bake_job.h"
 #include "skybake/viewer.h"
 #include "skybake/visibility.h"
 
@@ -38,14 +39,14 @@ struct ViewModelOpts {
 // the CPU), as every front end resolves it (resolve_tracer()).
 std::function<ViewerModel(const ViewerModel&)> make_viewer_bake() {
     return [](const ViewerModel& in) {
-        const auto tracer = make_visibility_tracer(resolve_tracer(TracerRequest{})); // device auto
         ViewerModel out = in;
-        TransferOptions t;
-        t.order = 3;
-        BakeOptions b;
-        b.method = tracer->method();
-        const SphereRule rule = parse_rule("lebedev:590");
-        bake_transfer(out.mesh, rule, *tracer, b, t, out.albedo, nullptr, out.transfer);
+        BakeJob job; // device auto
+        job.rule = parse_rule("lebedev:590");
+        job.shading = false;
+        job.transfer.emplace();
+        job.transfer->order = 3;
+        job.albedo = out.albedo;
+        out.transfer = run_bake_job(out.mesh, job).transfer;
         return out;
     };
 }

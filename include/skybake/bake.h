@@ -310,6 +310,9 @@ struct AoPreviewOptions {
     float elevation_deg = 30.0f; // camera above the xz plane
     float fov_y_deg = 35.0f;   // vertical field of view
     int samples = 2;           // per pixel and axis (2: 4 samples per pixel)
+    // Ray queries that already hold this mesh with both sides occluding (a
+    // bake's backend), used instead of building an Embree scene; or nullptr.
+    const RayQueries* queries = nullptr;
 };
 
 // The camera of the previews (and of `skybake view MODEL`): a pinhole looking

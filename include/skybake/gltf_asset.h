@@ -3,6 +3,7 @@
 //
 // [SECTION] What survives
 // [SECTION] The asset
+// [SECTION] A bake's file
 //
 // load_mesh() flattens a scene into one Mesh and forgets the rest of the
 // file. A GltfAsset keeps the document itself: its JSON, member for member
@@ -102,6 +103,38 @@ private:
     struct State;
     explicit GltfAsset(std::unique_ptr<State> state);
     std::unique_ptr<State> state_;
+};
+
+// [SECTION] A bake's file -------------------------------------------------------------
+//
+// What every command that bakes into a mesh reads and writes (ao, prt bake):
+// a glTF 2.0 input written as .glb or .gltf keeps its whole document (a
+// GltfAsset); another input, or a .ply output, is a plain Mesh written by
+// save_mesh().
+class BakeFile {
+public:
+    // Reads `input` for a bake that will write `output` (.glb, .gltf or
+    // .ply). Throws skybake::Error as load_mesh() does, and ("output") for a
+    // .gltf output of an input that is not glTF 2.0.
+    static BakeFile open(const std::filesystem::path& input, const std::filesystem::path& output,
+                         const ImportLimits& limits = {});
+    BakeFile(BakeFile&&) noexcept;
+    BakeFile& operator=(BakeFile&&) noexcept;
+    ~BakeFile();
+
+    Mesh& mesh();
+    const Mesh& mesh() const;
+    const ImportReport& report() const;
+    // The kept document, or nullptr for a plain mesh.
+    GltfAsset* document();
+    // GltfAsset::save(), or save_mesh() with `options` (temporary file, then rename).
+    void save(const std::filesystem::path& output, const ExportOptions& options = {}) const;
+
+private:
+    BakeFile();
+    std::unique_ptr<GltfAsset> asset_;
+    Mesh plain_;
+    ImportReport report_;
 };
 
 } // namespace skybake

@@ -356,15 +356,26 @@ std::string export_prt_glsl(int order, int channels, const PrtShaderOptions& opt
 //   {"format": "skybake-prt", "version": 1, "order": 3, "coefficients": 16,
 //    "channels": 1, "kind": "shadowed", "model": "prt", "bounces": 0,
 //    "rule": "lebedev:590", "albedo": "vertex-colors" | [r, g, b],
-//    "vertices": 1234, "attributes": ["prt_0", ...]}
+//    "vertices": 1234, "attributes": ["prt_0", ...], "colors": "white-sky" (optional)}
 
 // OUT.glb → OUT.prt.json.
 std::filesystem::path prt_sidecar_path(const std::filesystem::path& mesh_path);
 // Stores the transfer and the albedo on the mesh as attributes.
 void set_transfer_attributes(Mesh& mesh, const Transfer& transfer, std::span<const glm::vec3> albedo);
+// Sets mesh.colors to what the vertex receives from a uniform white sky, in
+// grey, without its albedo: 2√π T_00 (the mean of the channels), clamped to
+// [0, 1]. For a shadowed transfer this is the ambient occlusion from the same
+// bits (see [SECTION] Definitions); interreflected adds the bounces' light;
+// unshadowed is 1. What `prt bake` writes as COLOR_0, like `ao`, so that any
+// glTF viewer shows the bake.
+void set_white_sky_colors(Mesh& mesh, const Transfer& transfer);
 // The sidecar's JSON text. albedo_source: "vertex-colors", or the constant
 // albedo as a JSON array "[r, g, b]" (stored as an array).
-std::string transfer_sidecar_json(const Transfer& transfer, std::size_t vertices, const std::string& albedo_source);
+// white_sky_colors: the mesh's colours are set_white_sky_colors()'s (written
+// "colors": "white-sky"); load_prt() then drops them, as they are not a
+// colour of the surface (the albedo attribute holds that).
+std::string transfer_sidecar_json(const Transfer& transfer, std::size_t vertices, const std::string& albedo_source,
+                                  bool white_sky_colors = false);
 
 // Light file (`skybake sky sh`):
 //   {"format": "skybake-sh-light", "version": 1, "order": 3,

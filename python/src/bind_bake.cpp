@@ -6,6 +6,7 @@
 
 #include "common.h"
 #include "skybake/bake.h"
+#include "skybake/bake_job.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 #include "skybake/visibility.h"
@@ -82,13 +83,17 @@ void bind_bake(py::module_& m) {
            std::uint32_t resolution, float max_distance, float offset, const std::string& back_faces, bool normalize,
            bool store_bits, py::object progress, const std::string& device) {
             const SphereRule rule = parse_rule(rule_spec);
-            BakeOptions b = bake_options(max_distance, offset, back_faces, normalize);
-            b.store_bits = store_bits;
-            BakeOutputs out;
-            AoBakeReport report = long_call(std::move(progress), [&] {
-                const auto tracer = make_tracer(device, backend, method, resolution, &b.method);
-                return bake_ambient_occlusion(mesh, rule, *tracer, b, &out);
-            });
+            BakeJob job;
+            job.rule = rule;
+            job.options = bake_options(max_distance, offset, back_faces, normalize);
+            job.bits = store_bits;
+            job.tracer.device = device;
+            job.tracer.backend = backend;
+            job.tracer.method = method.value_or("");
+            job.tracer.resolution = resolution;
+            BakeJobResult done = long_call(std::move(progress), [&] { return run_bake_job(mesh, job); });
+            BakeOutputs& out = done.outputs;
+            AoBakeReport& report = done.ao;
             BakeResult r;
             const auto n = py::ssize_t(mesh.vertex_count());
             r.ao = to_numpy(std::move(out.ao), {n});

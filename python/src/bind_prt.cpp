@@ -8,6 +8,7 @@
 #include "skybake/files.h"
 #include "skybake/prt.h"
 #include "skybake/sky_source.h"
+#include "skybake/bake_job.h"
 
 namespace skybake::python {
 
@@ -73,24 +74,17 @@ void bind_prt(py::module_& m) {
             t.kind = parse_transfer_kind(kind);
             t.model = parse_transfer_model(model);
             t.bounces = bounces;
-            BakeOptions b = bake_options(max_distance, 0.0f, "occlude", false);
-            std::vector<glm::vec3> rho = albedo.is_none() ? mesh_albedo(mesh) : albedo_arg(albedo, mesh.vertex_count());
-            Transfer out;
-            long_call(std::move(progress), [&] {
-                TracerRequest request;
-                request.device = device;
-                request.backend = backend;
-                request.method = method.value_or("");
-                request.resolution = resolution;
-                request.closest_hit = t.kind == TransferKind::Interreflected;
-                const TracerChoice choice = resolve_tracer(request);
-                b.method = choice.method;
-                const auto tracer = make_visibility_tracer(choice);
-                std::unique_ptr<RayQueries> queries;
-                if (request.closest_hit)
-                    queries = make_ray_queries(choice);
-                bake_transfer(mesh, rule, *tracer, b, t, rho, queries.get(), out);
-            });
+            BakeJob job;
+            job.rule = rule;
+            job.options = bake_options(max_distance, 0.0f, "occlude", false);
+            job.shading = false;
+            job.transfer = t;
+            job.albedo = albedo.is_none() ? mesh_albedo(mesh) : albedo_arg(albedo, mesh.vertex_count());
+            job.tracer.device = device;
+            job.tracer.backend = backend;
+            job.tracer.method = method.value_or("");
+            job.tracer.resolution = resolution;
+            Transfer out = long_call(std::move(progress), [&] { return run_bake_job(mesh, job).transfer; });
             return out;
         },
         py::arg("mesh"), py::arg("rule") = "lebedev:590", py::arg("order") = 3, py::arg("kind") = "shadowed",

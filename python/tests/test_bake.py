@@ -306,3 +306,27 @@ def test_raster_backend_bakes_the_bowl(bowl):
     assert abs(np.median(r.ao[inner]) - 0.5) < 0.01
     e = skybake.bake_ao(bowl.copy(), rule="lebedev:590")
     assert np.mean(np.abs(r.ao - e.ao)) < 0.01
+
+
+def test_one_job_the_cli_and_python_give_identical_bits(cli, tmp):
+    """`ao --bits` and bake_ao(store_bits=True), `prt bake` and bake_transfer run the same job: same bits."""
+    m = skybake.generate_mesh("city", 3000, seed=5)
+    m.compute_normals()
+    src = tmp / "city.ply"
+    skybake.save_mesh(src, m)
+    r = skybake.bake_ao(m.copy(), rule="lebedev:110", store_bits=True)
+    cli("ao", src, "-o", tmp / "out.ply", "--rule", "lebedev:110", "--bits", tmp / "out.bits", "--quiet")
+    data = (tmp / "out.bits").read_bytes()
+    assert data[:8] == b"SKBVIS01"
+    vertices, directions, words, spec_len = np.frombuffer(data[8:24], dtype="<u4")
+    assert (vertices, words) == (m.vertex_count, r.bits.shape[1])
+    bits = np.frombuffer(data[24 + spec_len:], dtype="<u4").reshape(vertices, words)
+    np.testing.assert_array_equal(bits, r.bits)
+    out = skybake.load_mesh(tmp / "out.ply")
+    np.testing.assert_array_equal(out.attribute("ao"), r.ao)
+
+    t = skybake.bake_transfer(m.copy(), rule="lebedev:110", order=2, kind="interreflected", bounces=1)
+    cli("prt", "bake", src, "-o", tmp / "prt.ply", "--rule", "lebedev:110", "--order", "2", "--bounces", "1",
+        "--quiet")
+    mesh, transfer, albedo = skybake.load_prt(tmp / "prt.ply")
+    np.testing.assert_array_equal(transfer.coeffs, t.coeffs)

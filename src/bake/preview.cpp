@@ -48,8 +48,13 @@ Image bake::render_preview(const Mesh& mesh, const AoPreviewOptions& o, const ba
     if (!(o.fov_y_deg > 1.0f && o.fov_y_deg < 170.0f))
         throw Error(fmt::format("field of view {} degrees is out of range; use 1 to 170", o.fov_y_deg), "fov_y_deg");
 
-    const auto backend = make_ray_queries("embree");
-    backend->set_mesh(mesh, BackFaces::Occlude);
+    std::unique_ptr<RayQueries> own;
+    const RayQueries* backend = o.queries;
+    if (!backend) {
+        own = make_ray_queries("embree");
+        own->set_mesh(mesh, BackFaces::Occlude);
+        backend = own.get();
+    }
 
     const PreviewCamera cam = preview_camera(mesh, o);
     const glm::vec3 eye = cam.eye, forward = cam.forward, right = cam.right, up = cam.up;

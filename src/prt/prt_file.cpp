@@ -1,5 +1,6 @@
 // A baked mesh's transfer: vec4 attributes "prt_0", ... and the JSON sidecar
 // that says how to read them (skybake/prt.h, [SECTION] Files).
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <cstdint>
@@ -36,6 +37,7 @@ int json_int(const nlohmann::json& v, const char* field) {
 struct SidecarHeader {
     Transfer transfer; // without coefficients
     std::size_t vertices = 0;
+    bool baked_colors = false; // "colors": "white-sky": COLOR_0 is the bake's, not the material's
 };
 
 // The sidecar's own checks, before its mesh is read.
@@ -60,6 +62,7 @@ SidecarHeader parse_sidecar(std::string_view text, const std::string& side) {
         t.model = parse_transfer_model(j.at("model").get<std::string>());
         t.bounces = json_int(j.at("bounces"), "bounces");
         t.rule = j.at("rule").get<std::string>();
+        h.baked_colors = j.value("colors", "") == "white-sky";
         const nlohmann::json& n = j.at("vertices");
         if (!n.is_number_unsigned())
             throw nlohmann::json::type_error::create(302, "vertices must be a count, not " + n.dump(), &n);
@@ -81,6 +84,8 @@ SidecarHeader parse_sidecar(std::string_view text, const std::string& side) {
 PrtModel attach_transfer(SidecarHeader h, Mesh mesh, const std::string& side, const std::string& mesh_name) {
     PrtModel m;
     m.mesh = std::move(mesh);
+    if (h.baked_colors)
+        m.mesh.colors.clear(); // the bake's picture of itself, not a colour of the surface
     m.transfer = std::move(h.transfer);
     Transfer& t = m.transfer;
     const std::size_t n = m.mesh.vertex_count();
@@ -122,6 +127,21 @@ std::filesystem::path prt_sidecar_path(const std::filesystem::path& mesh_path) {
     return p;
 }
 
+void set_white_sky_colors(Mesh& mesh, const Transfer& transfer) {
+    const std::size_t n = mesh.vertex_count();
+    if (transfer.vertices() != n)
+        throw Error(fmt::format("transfer for {} vertices, mesh of {}", transfer.vertices(), n), "transfer");
+    const float two_sqrt_pi = 2.0f * std::sqrt(3.14159265358979f);
+    mesh.colors.resize(n);
+    for (std::size_t v = 0; v < n; ++v) {
+        float sum = 0.0f;
+        for (int c = 0; c < transfer.channels; ++c)
+            sum += transfer.vertex(v, c)[0];
+        const float g = std::clamp(two_sqrt_pi * sum / float(transfer.channels), 0.0f, 1.0f);
+        mesh.colors[v] = glm::vec4(g, g, g, 1.0f);
+    }
+}
+
 void set_transfer_attributes(Mesh& mesh, const Transfer& transfer, std::span<const glm::vec3> albedo) {
     const std::size_t n = mesh.vertex_count();
     if (transfer.vertices() != n)
@@ -148,7 +168,8 @@ void set_transfer_attributes(Mesh& mesh, const Transfer& transfer, std::span<con
         mesh.set_attribute("shading", 1, transfer.shading);
 }
 
-std::string transfer_sidecar_json(const Transfer& t, std::size_t vertices, const std::string& albedo_source) {
+std::string transfer_sidecar_json(const Transfer& t, std::size_t vertices, const std::string& albedo_source,
+                                  bool white_sky_colors) {
     nlohmann::json attrs = nlohmann::json::array();
     for (int a = 0; a < attribute_count(t); ++a)
         attrs.push_back(fmt::format("prt_{}", a));
@@ -165,6 +186,8 @@ std::string transfer_sidecar_json(const Transfer& t, std::size_t vertices, const
                                                                   : nlohmann::json(albedo_source)},
                         {"vertices", vertices},
                         {"attributes", attrs}};
+    if (white_sky_colors)
+        j["colors"] = "white-sky";
     return j.dump(2) + "\n";
 }
 

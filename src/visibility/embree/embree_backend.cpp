@@ -367,7 +367,7 @@ void skybake_register_embree_tracer() {
     TracerBackend b;
     b.name = "embree";
     b.device = "cpu";
-    b.summary = "Intel Embree 3 on the CPU, every core (the CPU's default)";
+    b.summary = "Intel Embree 3, every core";
     b.methods = {TraceMethod::Bvh};
     b.closest_hit = true;
     b.make_tracer = [](TraceMethod, std::uint32_t) { return std::make_unique<visibility::EmbreeBackend>(); };
