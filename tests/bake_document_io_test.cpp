@@ -28,12 +28,7 @@ using Json = nlohmann::json;
 namespace {
 
 Json document(const fs::path& path) {
-    const std::string data = skybake::read_file(path);
-    if (path.extension() == ".gltf")
-        return Json::parse(data);
-    std::uint32_t len = 0;
-    std::memcpy(&len, data.data() + 12, 4);
-    return Json::parse(data.substr(20, len));
+    return Json::parse(skybake::test::gltf_json_text(path.string()));
 }
 
 // An accessor as its users see it, without where its bytes lie.
@@ -95,10 +90,7 @@ bool has_color0(const Json& doc) {
 }
 
 std::string blender() {
-    for (const char* dir : {"/usr/bin", "/usr/local/bin"})
-        if (fs::exists(fs::path(dir) / "blender"))
-            return (fs::path(dir) / "blender").string();
-    return {};
+    return skybake::test::blender_path();
 }
 
 // A red plane under a cube, as Blender exports them (.glb).

@@ -60,12 +60,7 @@ bpy.ops.export_scene.gltf(filepath=out, export_format=fmt)
 )";
 
 std::string blender() {
-    for (const char* dir : {"/usr/bin", "/usr/local/bin"}) {
-        const fs::path p = fs::path(dir) / "blender";
-        if (fs::exists(p))
-            return p.string();
-    }
-    return {};
+    return skybake::test::blender_path();
 }
 
 // Runs Blender to write `out`; false (with the reason in `why`) when it fails.
@@ -82,12 +77,7 @@ bool make_suzanne(const fs::path& out, const std::string& kind, std::string& why
 }
 
 Json document(const fs::path& path) {
-    const std::string data = skybake::read_file(path);
-    if (path.extension() == ".gltf")
-        return Json::parse(data);
-    std::uint32_t len = 0;
-    std::memcpy(&len, data.data() + 12, 4);
-    return Json::parse(data.substr(20, len));
+    return Json::parse(skybake::test::gltf_json_text(path.string()));
 }
 
 struct Case {

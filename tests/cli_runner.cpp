@@ -1,9 +1,12 @@
 #include "cli_runner.h"
 
 #include <csignal>
+#include <cstdint>
+#include <cstring>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -108,6 +111,27 @@ CliResult run_cli(const std::vector<std::string>& args, int timeout_s) {
 CliResult run_cli_interrupted(const std::vector<std::string>& args, double after_s, int sig, bool after_fork,
                               int timeout_s) {
     return run(args, timeout_s, after_s, sig, after_fork);
+}
+
+std::string blender_path() {
+    for (const char* dir : {"/usr/bin", "/usr/local/bin"}) {
+        const std::string p = std::string(dir) + "/blender";
+        if (access(p.c_str(), X_OK) == 0)
+            return p;
+    }
+    return {};
+}
+
+std::string gltf_json_text(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (path.size() >= 5 && path.compare(path.size() - 5, 5, ".gltf") == 0)
+        return data;
+    std::uint32_t len = 0;
+    if (data.size() < 20)
+        return {};
+    std::memcpy(&len, data.data() + 12, 4);
+    return data.substr(20, len);
 }
 
 } // namespace skybake::test

@@ -28,4 +28,10 @@ CliResult run_cli_interrupted(const std::vector<std::string>& args, double after
 // A fresh empty folder under the build tree's temp area, removed by the OS later.
 std::string temp_dir(const std::string& name);
 
+// Blender's executable (/usr/bin or /usr/local/bin), or "" without one.
+std::string blender_path();
+
+// The JSON text of a .gltf, or of a .glb's JSON chunk.
+std::string gltf_json_text(const std::string& path);
+
 } // namespace skybake::test
