@@ -17,6 +17,7 @@
 
 #include "neural/internal.h"
 #include "skybake/neural.h"
+#include "skybake/image_io.h"
 
 using namespace skybake;
 

@@ -25,6 +25,7 @@
 
 #include "skybake/error.h"
 #include "skybake/neural.h"
+#include "skybake/image_io.h"
 #include "neural/internal.h"
 
 using namespace skybake;

@@ -13,6 +13,7 @@
 #include "skybake/bake.h"
 #include "skybake/core.h"
 #include "skybake/mesh.h"
+#include "skybake/image_io.h"
 
 using skybake::test::run_cli;
 namespace fs = std::filesystem;

@@ -27,6 +27,7 @@
 #include "cli_runner.h"
 #include "skybake/files.h"
 #include "skybake/image.h"
+#include "skybake/image_io.h"
 #include "skybake/mesh.h"
 #include "skybake/texture_bake.h"
 

@@ -18,6 +18,7 @@
 
 #include "cli_runner.h"
 #include "skybake/neural.h"
+#include "skybake/image_io.h"
 
 namespace skybake {
 namespace {

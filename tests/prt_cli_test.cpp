@@ -11,6 +11,7 @@
 #include "cli_runner.h"
 #include "skybake/bake.h"
 #include "skybake/image.h"
+#include "skybake/image_io.h"
 #include "skybake/mesh.h"
 #include "skybake/prt.h"
 

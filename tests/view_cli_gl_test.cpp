@@ -32,6 +32,7 @@
 
 #include "cli_runner.h"
 #include "skybake/image.h"
+#include "skybake/image_io.h"
 #include "skybake/mesh.h"
 #include "skybake/neural.h"
 #include "skybake/prt.h"

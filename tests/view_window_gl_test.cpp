@@ -22,6 +22,7 @@
 
 #include "cli_runner.h"
 #include "skybake/image.h"
+#include "skybake/image_io.h"
 #include "skybake/viewer.h"
 
 namespace skybake {

@@ -30,6 +30,7 @@
 #include "skybake/sphere.h"
 #include "skybake/texture_bake.h"
 #include "skybake/visibility.h"
+#include "skybake/image_io.h"
 
 namespace skybake::cli {
 

@@ -17,6 +17,7 @@
 #include "sky_common.h"
 #include "skybake/files.h"
 #include "skybake/interrupt.h"
+#include "skybake/image_io.h"
 
 namespace skybake::cli {
 

@@ -15,6 +15,7 @@
 #include "skybake/files.h"
 #include "skybake/mesh.h"
 #include "skybake/prt.h"
+#include "skybake/image_io.h"
 
 namespace skybake::cli {
 

@@ -8,6 +8,7 @@
 #include "gl_flags.h"
 #include "sky_common.h"
 #include "skybake/sky_source.h"
+#include "skybake/image_io.h"
 
 namespace skybake::cli {
 

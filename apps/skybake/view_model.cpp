@@ -17,6 +17,7 @@
 #include "skybake/bake_job.h"
 #include "skybake/viewer.h"
 #include "skybake/visibility.h"
+#include "skybake/image_io.h"
 
 namespace skybake::cli {
 

@@ -8,6 +8,7 @@
 #include "gl_flags.h"
 #include "sky_common.h"
 #include "skybake/image.h"
+#include "skybake/image_io.h"
 #include "skybake/viewer.h"
 
 namespace skybake::cli {

@@ -25,6 +25,7 @@
 #include <glm/vec3.hpp>
 
 #include "skybake/image.h"
+#include "skybake/image_io.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 #include "skybake/visibility.h"

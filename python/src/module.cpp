@@ -7,6 +7,7 @@
 #include "common.h"
 #include "skybake/core.h"
 #include "skybake/image.h"
+#include "skybake/image_io.h"
 #include "skybake/interrupt.h"
 #include "skybake/visibility.h"
 

@@ -4,4 +4,4 @@
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(EPOXY REQUIRED IMPORTED_TARGET epoxy)
 pkg_check_modules(EGL REQUIRED IMPORTED_TARGET egl)
-skybake_add_module(gl DEPENDS core io LIBS fmt::fmt PkgConfig::EGL PUBLIC_LIBS PkgConfig::EPOXY)
+skybake_add_module(gl DEPENDS core LIBS fmt::fmt PkgConfig::EGL PUBLIC_LIBS PkgConfig::EPOXY)

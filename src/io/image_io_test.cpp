@@ -10,6 +10,7 @@
 
 #include "skybake/error.h"
 #include "skybake/image.h"
+#include "skybake/image_io.h"
 
 // stb_image, the reference decoder for JPEG here (skybake reads JPEG with libjpeg-turbo).
 #define STB_IMAGE_IMPLEMENTATION

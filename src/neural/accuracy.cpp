@@ -10,6 +10,7 @@
 
 #include "neural/internal.h"
 #include "skybake/error.h"
+#include "skybake/image_io.h"
 
 namespace skybake {
 

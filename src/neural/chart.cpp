@@ -11,6 +11,7 @@
 #include "skybake/error.h"
 #include "skybake/files.h"
 #include "skybake/neural.h"
+#include "skybake/image_io.h"
 
 namespace skybake {
 

@@ -7,6 +7,7 @@
 
 #include "skybake/error.h"
 #include "skybake/image.h"
+#include "skybake/image_io.h"
 #include "skybake/prt.h"
 
 namespace skybake {

@@ -6,6 +6,7 @@
 
 #include "core/test_paths.h"
 #include "skybake/image.h"
+#include "skybake/image_io.h"
 #include "skybake/mesh.h"
 #include "skybake/prt.h"
 

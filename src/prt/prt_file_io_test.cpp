@@ -11,6 +11,7 @@
 #include "skybake/error.h"
 #include "skybake/files.h"
 #include "skybake/prt.h"
+#include "skybake/image_io.h"
 
 namespace skybake {
 namespace {

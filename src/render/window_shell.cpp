@@ -17,6 +17,7 @@
 #include "render/shaders.h"
 #include "skybake/error.h"
 #include "skybake/interrupt.h"
+#include "skybake/image_io.h"
 
 namespace skybake::render {
 

@@ -21,6 +21,7 @@
 #include <GLFW/glfw3.h>
 
 #include "skybake/image.h"
+#include "skybake/image_io.h"
 
 namespace skybake::render {
 

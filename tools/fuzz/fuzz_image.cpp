@@ -11,7 +11,7 @@
 #include <cstdlib>
 
 #include "skybake/error.h"
-#include "skybake/image.h"
+#include "skybake/image_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     if (size < 1 || size > (1 << 20))
