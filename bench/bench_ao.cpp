@@ -30,7 +30,7 @@
 #include "skybake/core.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
-#include "bake/driver.h"
+#include "bake/internal.h"
 #include "visibility/embree/embree_backend.h"
 #include "visibility/trace_hd.h"
 

@@ -32,7 +32,7 @@
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 #include "skybake/visibility.h"
-#include "bake/driver.h"
+#include "bake/internal.h"
 #include "skybake/bake.h"
 #include "visibility/trace_hd.h"
 #include "visibility/cuda/bvh.h"

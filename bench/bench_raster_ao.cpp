@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "ao_scenes.h"
-#include "bake/driver.h"
+#include "bake/internal.h"
 #include "skybake/bake.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"

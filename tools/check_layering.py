@@ -4,7 +4,9 @@
 Each module's allowed dependencies are its DEPENDS in src/CMakeLists.txt or
 src/*/*.cmake (and theirs, transitively). A file of src/MODULE/ - sources, headers and tests alike -
 may include "OTHER/..." or the public header of OTHER only when MODULE depends
-on OTHER. Prints each violation and exits 1 if there is any.
+on OTHER, and never OTHER's internal headers (internal.h, NAME_internal.h):
+what a module shares with others is a header named for its concept (e.g.
+sky/device.h). Prints each violation and exits 1 if there is any.
 
     tools/check_layering.py [REPO_ROOT]
 """
@@ -62,6 +64,12 @@ for module in direct:
                         continue
                     top, rest = m.groups()
                     target = owner.get(rest) if top == "skybake" else (top if top in direct else None)
+                    base_name = os.path.basename(rest)
+                    if target and target != module and (base_name == "internal.h" or base_name.endswith("_internal.h")):
+                        rel = os.path.relpath(path, root)
+                        print(f"{rel}:{number}: {module} includes {top}/{rest}, an internal header of {target}")
+                        violations += 1
+                        continue
                     if target and target not in allowed[module]:
                         rel = os.path.relpath(path, root)
                         print(f"{rel}:{number}: {module} includes {top}/{rest}, a header of {target}, "
@@ -69,4 +77,4 @@ for module in direct:
                         violations += 1
 if violations:
     sys.exit(1)
-print(f"layering: {len(direct)} modules, no upward includes")
+print(f"layering: {len(direct)} modules, no upward includes, no other module's internal headers")

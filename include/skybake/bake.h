@@ -16,6 +16,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <span>
 #include <string>
@@ -190,6 +191,29 @@ struct VisibilityBakeStats {
 VisibilityBakeStats bake_visibility(const Mesh& mesh, const SphereRule& rule, VisibilityTracer& tracer,
                                     const BakeOptions& options, VisibilityReduction& reduction);
 
+// The trace inputs of one chunk of a bake's sample points, as the driver
+// builds them for trace(): the buffers, and the chunk that views them.
+struct ChunkInputs {
+    std::vector<glm::vec3> origins, normals, offsets;
+    std::vector<glm::mat3> rotations; // empty unless the rule rotates
+};
+// Fills `buffers` with the inputs of points [first, first + count) and
+// returns the TraceChunk over them, writing into `words` (count ×
+// words_per_vertex entries, or empty for device words). Safe to call from
+// several threads at once with distinct buffers.
+using ChunkBuilder = std::function<TraceChunk(std::uint32_t first, std::uint32_t count, ChunkInputs& buffers,
+                                              std::span<std::uint32_t> words)>;
+
+// A tracer that traces all of a bake's points before the driver's loop (the
+// distributed bake, skybake/distributed.h): after set_rule(), the driver
+// calls trace_points() once with the point count and a builder of any
+// chunk's inputs; its loop then calls trace() as usual, in order, and the
+// tracer hands out the words it traced then.
+class WholeBakeTracer : public VisibilityTracer {
+public:
+    virtual void trace_points(std::uint32_t points, const ChunkBuilder& build) = 0;
+};
+
 // Sample points other than the mesh's vertices (texel centres of a texture
 // bake, skybake/texture_bake.h): the bake measures visibility at points on
 // the mesh's surface, of which its vertices are one kind. Point i's ray
@@ -208,6 +232,41 @@ struct SamplePoints {
 VisibilityBakeStats bake_visibility(const Mesh& mesh, const SamplePoints& points, const SphereRule& rule,
                                     VisibilityTracer& tracer, const BakeOptions& options,
                                     VisibilityReduction& reduction);
+
+// [SECTION] Passes over the bake's rays -------------------------------------------
+//
+// Work that needs hits rather than bits, from the ray origins of
+// bake_visibility() (the same vertex normals, offsets and rounding steps): a
+// bounce or a sun ray leaves a vertex where its visibility rays left it.
+
+// The unit normal of each vertex as a bake uses it, the horizon of its
+// directions: mesh.normals normalised or, where one is zero or not finite,
+// the area-weighted normal of the vertex's triangles.
+std::vector<glm::vec3> bake_vertex_normals(const Mesh& mesh);
+
+// One blocked direction of a vertex, and what blocks it.
+struct BlockedDirection {
+    std::uint32_t vertex = 0;
+    std::uint32_t direction = 0; // rule index k
+    float weight = 0.0f;         // the rule's weight of k, single precision
+    float cosine = 0.0f;         // n · x_k, > 0
+    RayHit hit;                  // the closest blocker; triangle kNoHit past max_distance
+};
+
+// Every vertex's directions above its horizon (n · x_k > 0) whose bit in
+// `words` is 0, each with the closest hit of the ray from the vertex's ray
+// origin along it: by vertex, then in the bake's visiting order. `words` as
+// bake_visibility() stores them (skybake/visibility.h, [SECTION] Visibility
+// words) for the same mesh, rule and options; `queries` holds the mesh. The
+// gather of the bounces of skybake/prt.h. Throws skybake::Error ("words")
+// when the words do not fit the mesh and the rule.
+std::vector<BlockedDirection> blocked_directions(const Mesh& mesh, const SphereRule& rule, const BakeOptions& options,
+                                                 std::span<const std::uint32_t> words, const RayQueries& queries);
+
+// Per vertex: 1 where the vertex faces `direction` (n · d ≥ 0, d unit) and
+// the ray from its ray origin along d meets nothing within max_distance, else 0.
+std::vector<std::uint8_t> direction_visibility(const Mesh& mesh, const glm::vec3& direction,
+                                               const BakeOptions& options, const RayQueries& queries);
 
 // The reduction behind bake_ambient_occlusion(): AO, A and the bent normal of
 // every vertex into `out` (and the words, with options.store_bits).

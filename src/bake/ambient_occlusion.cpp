@@ -11,7 +11,7 @@
 
 #include <fmt/format.h>
 
-#include "bake/driver.h"
+#include "bake/internal.h"
 #include "bake/shading_cuda.h"
 #include "bake/shading_hd.h"
 #include "core/parallel.h"

@@ -24,7 +24,7 @@
 #include <glm/geometric.hpp>
 
 #include "bake/ao_test_util.h"
-#include "bake/driver.h"
+#include "bake/internal.h"
 #include "skybake/bake.h"
 #include "skybake/core.h"
 #include "skybake/error.h"

@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "bake/driver.h"
+#include "bake/internal.h"
 #include "skybake/bake.h"
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"

@@ -85,27 +85,4 @@ struct VertexRays {
 };
 VertexRays vertex_rays(const Mesh& mesh, const BakeOptions& options);
 
-// The trace inputs of one chunk of a bake's sample points, as the driver
-// builds them for trace(): the buffers, and the chunk that views them.
-struct ChunkInputs {
-    std::vector<glm::vec3> origins, normals, offsets;
-    std::vector<glm::mat3> rotations; // empty unless the rule rotates
-};
-// Fills `buffers` with the inputs of points [first, first + count) and
-// returns the TraceChunk over them, writing into `words` (count ×
-// words_per_vertex entries, or empty for device words). Safe to call from
-// several threads at once with distinct buffers.
-using ChunkBuilder = std::function<TraceChunk(std::uint32_t first, std::uint32_t count, ChunkInputs& buffers,
-                                              std::span<std::uint32_t> words)>;
-
-// A tracer that traces all of a bake's points before the driver's loop (the
-// distributed bake, skybake/distributed.h): after set_rule(), the driver
-// calls trace_points() once with the point count and a builder of any
-// chunk's inputs; its loop then calls trace() as usual, in order, and the
-// tracer hands out the words it traced then.
-class WholeBakeTracer : public VisibilityTracer {
-public:
-    virtual void trace_points(std::uint32_t points, const ChunkBuilder& build) = 0;
-};
-
 } // namespace skybake::bake

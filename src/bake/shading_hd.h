@@ -32,7 +32,7 @@ using visibility::vertex_direction;
 // [SECTION] Reduction -------------------------------------------------------------------
 //
 // The directions are visited in one fixed order, the rule's coherent order
-// (order[j] = k, see coherent_direction_order() in bake/driver.h); the j-th one
+// (order[j] = k, see coherent_direction_order() in bake/internal.h); the j-th one
 // goes to partial sum j mod kReduceLanes, and the partials are added in lane
 // order at the end. Every backend follows this order, so all of them get the
 // same bits of float from the same visibility, and CPU loops vectorise.

@@ -13,7 +13,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
-#include "bake/driver.h"
+#include "bake/internal.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "skybake/bake.h"
@@ -133,7 +133,7 @@ VisibilityBakeStats bake_points(const Mesh& mesh, std::uint32_t n, float ray_off
     const std::uint32_t chunk =
         std::max<std::uint32_t>(1, std::min({wanted, tracer_limit, memory_limit, std::max(n, 1u)}));
 
-    const bake::ChunkBuilder build = [&](std::uint32_t first, std::uint32_t count, bake::ChunkInputs& in,
+    const ChunkBuilder build = [&](std::uint32_t first, std::uint32_t count, ChunkInputs& in,
                                          std::span<std::uint32_t> out_words) {
         in.origins.resize(std::max<std::size_t>(in.origins.size(), count));
         in.normals.resize(std::max<std::size_t>(in.normals.size(), count));
@@ -159,10 +159,10 @@ VisibilityBakeStats bake_points(const Mesh& mesh, std::uint32_t n, float ray_off
         tc.words = out_words;
         return tc;
     };
-    if (auto* whole = dynamic_cast<bake::WholeBakeTracer*>(&tracer))
+    if (auto* whole = dynamic_cast<WholeBakeTracer*>(&tracer))
         whole->trace_points(n, build);
 
-    bake::ChunkInputs inputs;
+    ChunkInputs inputs;
     std::vector<std::uint32_t> chunk_words(host_words ? std::size_t(chunk) * words : 0);
     Progress progress("bake", n);
     for (std::uint32_t first = 0; first < n; first += chunk, ++stats.chunks) {

@@ -15,7 +15,7 @@
 #include "skybake/mesh.h"
 #include "skybake/sphere.h"
 #include "skybake/visibility.h"
-#include "bake/driver.h"
+#include "bake/internal.h"
 #include "bake/shading_hd.h"
 #include "skybake/bake.h"
 #include "visibility/cuda/test_scenes.h"

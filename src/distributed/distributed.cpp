@@ -27,8 +27,8 @@
 
 #include <fmt/format.h>
 
-#include "bake/driver.h"
 #include "core/progress.h"
+#include "skybake/bake.h"
 #include "skybake/core.h"
 #include "skybake/interrupt.h"
 
@@ -301,7 +301,7 @@ void run_queue(std::size_t count, const TaskWork& work, const TaskCollect& colle
 }
 
 // The tracer behind make_distributed_tracer().
-class DistributedTracer final : public bake::WholeBakeTracer {
+class DistributedTracer final : public WholeBakeTracer {
 public:
     explicit DistributedTracer(std::unique_ptr<VisibilityTracer> local) : local_(std::move(local)) {}
 
@@ -323,7 +323,7 @@ public:
     // once: trace() then collects chunks while the driver reduces the ones
     // before, so that the reduction overlaps the tracing of the rest. The
     // other ranks trace their share here and return when the queue is empty.
-    void trace_points(std::uint32_t n, const bake::ChunkBuilder& build) override {
+    void trace_points(std::uint32_t n, const ChunkBuilder& build) override {
         const int ranks = g_joined ? g_rank.size : 1;
         const std::uint32_t w = words_per_point_;
         // Chunks: as the single-process driver sizes them for a CPU tracer
@@ -406,7 +406,7 @@ private:
 
     std::vector<char> trace_task(std::size_t t) {
         const auto [first, count] = range(t);
-        thread_local bake::ChunkInputs inputs;
+        thread_local ChunkInputs inputs;
         std::vector<char> bytes(std::size_t(count) * words_per_point_ * 4);
         const TraceChunk tc = build_(first, count, inputs,
                                      std::span<std::uint32_t>(reinterpret_cast<std::uint32_t*>(bytes.data()),
@@ -430,7 +430,7 @@ private:
     }
 
     std::uint32_t n_ = 0, chunk_ = 1;
-    bake::ChunkBuilder build_;
+    ChunkBuilder build_;
     std::atomic<int> traced_here_{0};
     DistributedStats stats_;
     std::chrono::steady_clock::time_point start_;

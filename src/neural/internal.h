@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include "neural/device.h"
 #include "neural/mlp_hd.h"
 #include "skybake/neural.h"
 
@@ -30,7 +31,6 @@ struct Layout {
 };
 
 Layout make_layout(const NeuralTopology& topology);
-MlpHD make_mlp_hd(const NeuralSky& net);
 // The encoding part of MlpHD (inputs, decoding constants, phase terms).
 void set_encoding_hd(const NeuralEncoding& encoding, const Atmosphere& atmosphere, MlpHD& m);
 // Indices of the atmosphere's components that scatter (a phase function and

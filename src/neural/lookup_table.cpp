@@ -14,7 +14,7 @@
 #include "core/parallel.h"
 #include "neural/internal.h"
 #include "neural/render_hd.h"
-#include "sky/internal.h"
+#include "sky/device.h"
 #include "skybake/error.h"
 
 namespace skybake {

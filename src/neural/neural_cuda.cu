@@ -14,7 +14,7 @@
 #include "neural/mlp_hd.h"
 #include "neural/neural_cuda.h"
 #include "neural/render_hd.h"
-#include "sky/internal.h"
+#include "sky/device.h"
 #include "skybake/core.h"
 
 namespace skybake::neural {

@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "neural/internal.h"
-#include "sky/internal.h"
+#include "sky/device.h"
 #include "skybake/core.h"
 #include "skybake/error.h"
 #include "skybake/neural.h"

@@ -25,7 +25,7 @@
 #include "skybake/core.h"
 #include "core/random.h"
 #include "skybake/error.h"
-#include "sky/internal.h"
+#include "sky/device.h"
 
 namespace skybake {
 

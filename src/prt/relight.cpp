@@ -5,7 +5,6 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
-#include "bake/driver.h"
 #include "bake/preview.h"
 #include "core/parallel.h"
 #include "skybake/error.h"
@@ -54,20 +53,8 @@ std::vector<glm::vec3> relight(const Transfer& transfer, const ShLight& light, s
 }
 
 std::vector<float> sun_visibility(const Mesh& mesh, const glm::vec3& sun_direction, RayQueries& queries) {
-    BakeOptions options;
-    const bake::VertexRays vr = bake::vertex_rays(mesh, options);
-    const std::size_t n = mesh.vertex_count();
-    std::vector<Ray> rays(n);
-    for (std::size_t v = 0; v < n; ++v) {
-        rays[v].origin = vr.origin(mesh, v);
-        rays[v].direction = sun_direction;
-    }
-    std::vector<std::uint8_t> occ(n);
-    queries.occluded(rays, occ);
-    std::vector<float> out(n);
-    for (std::size_t v = 0; v < n; ++v)
-        out[v] = occ[v] || glm::dot(vr.normals[v], sun_direction) < 0.0f ? 0.0f : 1.0f;
-    return out;
+    const std::vector<std::uint8_t> lit = direction_visibility(mesh, sun_direction, BakeOptions{}, queries);
+    return std::vector<float>(lit.begin(), lit.end());
 }
 
 Image render_prt_preview(const Mesh& mesh, const Transfer& transfer, std::span<const glm::vec3> diffuse,
@@ -79,7 +66,7 @@ Image render_prt_preview(const Mesh& mesh, const Transfer& transfer, std::span<c
     if (!(phong_exponent >= 0.0) || !std::isfinite(phong_exponent))
         throw Error(fmt::format("the Phong exponent must be ≥ 0; got {}", phong_exponent), "exponent");
     const bool glossy = phong_exponent > 0.0 && specular > 0.0f;
-    std::vector<glm::vec3> normals = bake::bake_normals(mesh);
+    std::vector<glm::vec3> normals = bake_vertex_normals(mesh);
     const SphereRule rule = glossy ? phong_rule(phong_exponent, light.order / 2 + 1) : SphereRule{};
     const std::vector<glm::dvec3> c(light.coeffs.begin(), light.coeffs.end());
     const bool have_a = transfer.shading.size() == n;

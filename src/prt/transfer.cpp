@@ -11,7 +11,6 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
-#include "bake/driver.h"
 #include "core/parallel.h"
 #include "skybake/error.h"
 #include "skybake/names.h"
@@ -131,42 +130,20 @@ void add_bounces(const Mesh& mesh, const SphereRule& rule, const BakeOptions& ba
                  TransferReport& report) {
     const std::size_t n = mesh.vertex_count();
     const int nc = out.coefficients;
-    const bake::VisitingRule visit = bake::visiting_rule(rule);
-    const bake::VertexRays vr = bake::vertex_rays(mesh, bake);
-    const std::uint32_t words = visit.words_per_vertex;
-    const std::vector<std::uint32_t>& bits = red.words();
 
-    // Closest hits of every occluded direction above the horizon, once.
+    // Closest hits of every occluded direction above the horizon, once, from
+    // the bake's own ray origins.
     struct Gather {
         std::uint32_t vertex, triangle;
         float weight, u, v; // weight: w_k 4 (n·x_k)
     };
     std::vector<Gather> gathers;
-    std::vector<Ray> rays;
-    for (std::size_t v = 0; v < n; ++v) {
-        const glm::mat3 rot = visit.rotation(std::uint32_t(v));
-        const glm::vec3 origin = vr.origin(mesh, v);
-        for (std::size_t j = 0; j < visit.points.size(); ++j) {
-            glm::vec3 x;
-            float cos_n;
-            visibility::vertex_direction(visit.points[j], rot, visit.rotate, vr.normals[v], x, cos_n);
-            if (!(cos_n > 0.0f) || visibility::get_bit(bits.data() + v * words, visit.order[j]))
-                continue;
-            Ray r;
-            r.origin = origin;
-            r.direction = x;
-            r.t_max = bake.max_distance;
-            rays.push_back(r);
-            gathers.push_back({std::uint32_t(v), kNoHit, 4.0f * visit.weights[j] * cos_n, 0.0f, 0.0f});
-        }
-    }
-    std::vector<RayHit> hits(rays.size());
-    queries.intersect(rays, hits);
-    report.bounce_rays = rays.size(); // traced once, gathered by every bounce
-    for (std::size_t g = 0; g < gathers.size(); ++g) {
-        gathers[g].triangle = hits[g].triangle;
-        gathers[g].u = hits[g].u;
-        gathers[g].v = hits[g].v;
+    {
+        const std::vector<BlockedDirection> blocked = blocked_directions(mesh, rule, bake, red.words(), queries);
+        report.bounce_rays = blocked.size(); // traced once, gathered by every bounce
+        gathers.reserve(blocked.size());
+        for (const BlockedDirection& b : blocked)
+            gathers.push_back({b.vertex, b.hit.triangle, 4.0f * b.weight * b.cosine, b.hit.u, b.hit.v});
     }
     // Gathers are grouped by vertex (pushed in vertex order).
     std::vector<std::size_t> start(n + 1, 0);
@@ -270,7 +247,7 @@ TransferReport bake_transfer(Mesh& mesh, const SphereRule& rule, VisibilityTrace
 
     if (options.model == TransferModel::ShadingCoefficient) {
         // T_lm = A (Â_l / π) Y_lm(n), A from the same bits.
-        const std::vector<glm::vec3> normals = bake::bake_normals(mesh);
+        const std::vector<glm::vec3> normals = bake_vertex_normals(mesh);
         const int nc = out.coefficients;
         std::vector<double> zonal(std::size_t(options.order) + 1);
         for (int l = 0; l <= options.order; ++l)

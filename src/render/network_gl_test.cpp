@@ -11,7 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "neural/error_bound_test_util.h"
-#include "neural/internal.h"
+#include "neural/device.h"
 #include "neural/mlp_hd.h"
 #include "gl/gl.h"
 #include "skybake/error.h"

@@ -17,7 +17,7 @@
 
 #include "render/planet_scene.h"
 #include "render/shaders.h"
-#include "sky/internal.h"
+#include "sky/device.h"
 #include "skybake/error.h"
 
 namespace skybake::render {

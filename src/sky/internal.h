@@ -1,32 +1,14 @@
-// Internal glue between the public sky API and the shared CPU/GPU maths.
+// Internal glue between the public sky API and the shared CPU/GPU maths
+// (the parts other modules share are in sky/device.h).
 #pragma once
 
 #include <glm/exponential.hpp>
 #include <glm/geometric.hpp>
 
-#include "core/parallel.h"
-#include "core/progress.h"
 #include "skybake/sky.h"
-#include "sky/render_hd.h"
-#include "sky/sky_hd.h"
+#include "sky/device.h"
 
 namespace skybake::sky {
-
-// Flat view of an atmosphere and its tables for the SKYBAKE_HD functions.
-// The result points into `tables`, which must outlive it.
-AtmosphereHD make_atmosphere_hd(const Atmosphere& atmosphere, const OpticalLengthTables& tables);
-
-// Observer state from a radius (km) and the three cosines.
-ObserverHD make_observer(const Atmosphere& atmosphere, double radius_km, double cos_view_zenith, double cos_view_sun,
-                         double cos_sun_zenith);
-
-// Observer state from a sky sample (ρ0 -> altitude of the first component).
-ObserverHD make_observer(const Atmosphere& atmosphere, const SkySample& sample);
-
-// The model's single-scattering table path split by component without the
-// phase functions (seed_sky_sum_split), over all cores:
-// out[i * components + k] for sample i and component k.
-void evaluate_sky_split(const SkyModel& model, std::span<const SkySample> samples, std::span<glm::vec3> out);
 
 // Exact in-scattered radiance (1/sr, per unit irradiance) along the segment
 // from `origin_km` in unit direction `dir` for length_km, with unit sun
@@ -48,35 +30,5 @@ glm::dvec3 optical_depth_exact(const Atmosphere& atmosphere, const glm::dvec3& o
 // entry distance (0 inside) and the exit or ground distance. False if it misses.
 bool atmosphere_segment(const Atmosphere& atmosphere, const glm::dvec3& origin_km, const glm::dvec3& dir,
                         double& enter_km, double& exit_km, bool& hits_ground);
-
-// Validates the settings (throws skybake::Error naming the flag) and sets up
-// the per-pixel parameters shared by the CPU and CUDA renderers.
-RenderHD make_render_hd(const SkyModel& model, const SkyRenderSettings& settings);
-
-// The CPU pixel loop: shade(dir) -> linear RGB for every pixel with a view
-// direction, rows in parallel, with a progress bar. Pixels without a
-// direction (outside the fisheye disc) stay black.
-template <class Shade>
-Image render_pixels(const RenderHD& p, Shade shade) {
-    Image image(p.width, p.height);
-    Progress progress("render", std::uint64_t(p.height));
-    parallel_for(std::size_t(p.height), 1, [&](std::size_t y0, std::size_t y1) {
-        for (std::size_t y = y0; y < y1; ++y) {
-            for (int x = 0; x < p.width; ++x) {
-                glm::vec3 d;
-                if (!pixel_direction(p, x, int(y), d))
-                    continue;
-                const glm::vec3 c = shade(d);
-                float* px = image.pixel(x, int(y));
-                px[0] = c.x;
-                px[1] = c.y;
-                px[2] = c.z;
-            }
-            progress.advance();
-        }
-    });
-    progress.finish();
-    return image;
-}
 
 } // namespace skybake::sky
