@@ -31,6 +31,17 @@ Json glb_json(const fs::path& path) {
     return Json::parse(data.substr(20, len));
 }
 
+// The bytes of image `index` of a .glb, from its BIN chunk.
+std::string glb_image_bytes(const fs::path& path, std::size_t index) {
+    const std::string data = skybake::read_file(path);
+    std::uint32_t len;
+    std::memcpy(&len, data.data() + 12, 4);
+    const Json j = Json::parse(data.substr(20, len));
+    const std::size_t bin = 20 + len + 8; // the BIN chunk's data, after its length and type
+    const Json& view = j["bufferViews"][j["images"][index]["bufferView"].get<std::size_t>()];
+    return data.substr(bin + view.value("byteOffset", std::size_t(0)), view["byteLength"].get<std::size_t>());
+}
+
 // The milk truck (glTF 1.0, read through Assimp): a textured model whose UVs lie in [0, 1].
 fs::path truck(const std::string& name) {
     const fs::path dir = skybake::test::temp_dir(name);
@@ -71,12 +82,16 @@ TEST(TextureCli, BakesAndWiresTheOcclusionTexture) {
         ASSERT_TRUE(material.contains("occlusionTexture")) << material.dump();
         const std::size_t texture = material["occlusionTexture"]["index"];
         const std::size_t image = j["textures"][texture]["source"];
-        EXPECT_EQ(j["images"][image]["uri"], "out_ao.png");
+        // A .glb embeds the image (and the file is written beside it too).
+        EXPECT_FALSE(j["images"][image].contains("uri")) << j["images"][image].dump();
+        EXPECT_EQ(j["images"][image]["mimeType"], "image/png");
+        EXPECT_EQ(glb_image_bytes(dir / "out.glb", image), skybake::read_file(dir / "out_ao.png"));
         EXPECT_EQ(material["occlusionTexture"].value("texCoord", 0), 0); // 0 is the default
         textured |= material["pbrMetallicRoughness"].contains("baseColorTexture");
     }
     EXPECT_TRUE(textured) << "the truck's own texture is still there";
 
+    // A glTF 2.0 input (.glb embeds, .gltf names the file): BlenderAssets.
     // EXR output, named by --texture-out.
     const auto e = run_cli({"ao", in.string(), "-o", (dir / "exr.glb").string(), "--texture", "64", "--rule",
                             "lebedev:50", "--texture-out", (dir / "ao.exr").string()});

@@ -71,7 +71,7 @@ std::string default_texture_path(const std::string& output) {
 
 // Wires `image` as the occlusion texture of a plain mesh's materials, giving
 // the parts without one (or the whole mesh) a material of their own.
-void wire_occlusion(Mesh& mesh, const std::string& image, int uv_set) {
+void wire_occlusion(Mesh& mesh, const std::string& image, int uv_set, const std::string& png) {
     int bare = -1;
     auto bare_material = [&] {
         if (bare < 0) {
@@ -90,6 +90,7 @@ void wire_occlusion(Mesh& mesh, const std::string& image, int uv_set) {
             part.material = bare_material();
     for (auto& m : mesh.materials) {
         m.occlusion_texture = image;
+        m.occlusion_image.assign(png.begin(), png.end());
         m.occlusion_texcoord = uv_set;
     }
 }
@@ -192,11 +193,17 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
         info("warning: UV set {} overlaps: {} texel centres lie in two or more triangles ({} triangles); "
              "the nearest triangle in mesh order wins there",
              o.uv, texture->overlapping_texels, texture->overlapping_triangles);
+    // A .glb embeds a PNG texture, so that it travels alone; the file is
+    // written beside it too. A .gltf names the file.
+    const bool texture_png = texture && lower_extension(texture_out) == ".png";
+    const std::string png =
+        texture_png ? encode_png16_gray(texture->texture_size, texture->texture_size, texture->ao) : std::string();
+    const std::string embedded = lower_extension(o.output) == ".glb" ? png : std::string();
     if (texture) {
         if (asset)
-            asset->set_occlusion_texture(texture_out, o.uv);
+            asset->set_occlusion_texture(texture_out, o.uv, embedded);
         else
-            wire_occlusion(mesh, std::filesystem::absolute(texture_out).string(), o.uv);
+            wire_occlusion(mesh, std::filesystem::absolute(texture_out).string(), o.uv, embedded);
     }
 
     if (job && !job_root())
@@ -218,7 +225,7 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
                 image.rgb[3 * k] = image.rgb[3 * k + 1] = image.rgb[3 * k + 2] = texture->ao[k];
             save_exr(files.stage(texture_out), image);
         } else {
-            save_png16_gray(files.stage(texture_out), n, n, texture->ao);
+            write_stream_atomic(files.stage(texture_out), [&](std::ostream& out) { out.write(png.data(), std::streamsize(png.size())); });
         }
     }
     files.commit();

@@ -91,7 +91,9 @@ public:
     // occlusionTexture of every material that a baked primitive uses, read
     // with UV set `uv_set`; primitives without a material get a new one that
     // has only that texture. An occlusionTexture the material had is replaced.
-    void set_occlusion_texture(const std::filesystem::path& image, int uv_set);
+    // With `png` (the image's PNG bytes), a .glb embeds it, named after the
+    // file, so that the .glb travels alone; a .gltf names the file.
+    void set_occlusion_texture(const std::filesystem::path& image, int uv_set, std::string png = {});
 
     // Writes the document to a .glb or .gltf file (temporary file, then
     // rename) with the attributes of mesh() that are new or changed since

@@ -31,6 +31,8 @@ void save_png_srgb8(const std::filesystem::path& path, int width, int height, co
 // row-major, top row first) as a 16-bit greyscale PNG, without the sRGB
 // curve: data such as an occlusion texture, which glTF reads linearly.
 void save_png16_gray(const std::filesystem::path& path, int width, int height, const std::vector<float>& values);
+// The same PNG, in memory (to embed in a .glb). Throws skybake::Error ("values").
+std::string encode_png16_gray(int width, int height, const std::vector<float>& values);
 
 // Reads an EXR or a Radiance .hdr (linear) or a PNG/JPEG (sRGB, decoded to linear).
 // Throws skybake::Error on a missing or corrupt file, and on one whose

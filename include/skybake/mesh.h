@@ -50,8 +50,10 @@ struct MeshMaterial {
     std::string base_color_image_type;
     int base_color_texcoord = 0; // the UV set (Mesh::texcoords) the image is mapped with
     // An ambient occlusion image (glTF occlusionTexture, read from its red
-    // channel), a path as base_color_texture; empty if none.
+    // channel), a path as base_color_texture; empty if none. With
+    // occlusion_image (its PNG bytes), a .glb embeds the image instead.
     std::string occlusion_texture;
+    std::vector<unsigned char> occlusion_image;
     int occlusion_texcoord = 0;
 };
 

@@ -140,11 +140,13 @@ struct GltfAsset::State {
     ImportReport report;
     std::filesystem::path occlusion_image; // empty: none
     int occlusion_uv_set = 0;
+    std::string occlusion_png; // the image's bytes, embedded by a .glb; empty: referenced by URI
 };
 
-void GltfAsset::set_occlusion_texture(const std::filesystem::path& image, int uv_set) {
+void GltfAsset::set_occlusion_texture(const std::filesystem::path& image, int uv_set, std::string png) {
     state_->occlusion_image = image;
     state_->occlusion_uv_set = uv_set;
+    state_->occlusion_png = std::move(png);
 }
 
 GltfAsset::GltfAsset(std::unique_ptr<State> state) : state_(std::move(state)) {}
@@ -373,11 +375,25 @@ void GltfAsset::save(const std::filesystem::path& path) const {
         Json& images = doc["images"];
         Json& textures = doc["textures"];
         std::size_t image = images.size(), texture = textures.size();
+        const bool embed = ext == ".glb" && !s.occlusion_png.empty();
+        // An embedded image carries the file's name as its name.
         for (std::size_t i = 0; i < images.size() && image == images.size(); ++i)
-            if (images[i].is_object() && images[i].value("uri", std::string()) == uri)
+            if (images[i].is_object() &&
+                (images[i].value("uri", std::string()) == uri ||
+                 (images[i].value("name", std::string()) == uri && images[i].contains("bufferView"))))
                 image = i;
         if (image == images.size())
-            images.push_back({{"uri", uri}});
+            images.push_back(Json::object());
+        if (embed) {
+            while (bin.size() % 4)
+                bin.push_back(0);
+            const std::size_t offset = bin.size();
+            bin.insert(bin.end(), s.occlusion_png.begin(), s.occlusion_png.end());
+            views.push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", s.occlusion_png.size()}});
+            images[image] = {{"name", uri}, {"bufferView", views.size() - 1}, {"mimeType", "image/png"}};
+        } else {
+            images[image] = {{"uri", uri}};
+        }
         for (std::size_t t = 0; t < textures.size() && texture == textures.size(); ++t)
             if (textures[t].is_object() && textures[t].contains("source") && textures[t]["source"] == image &&
                 !textures[t].contains("extensions"))

@@ -626,7 +626,8 @@ void write_glb(const std::filesystem::path& tmp, const Mesh& mesh) {
             gm.pbrMetallicRoughness.baseColorTexture.texCoord = m.base_color_texcoord;
         }
         if (!m.occlusion_texture.empty()) {
-            gm.occlusionTexture.index = referenced(m.occlusion_texture);
+            gm.occlusionTexture.index = m.occlusion_image.empty() ? referenced(m.occlusion_texture)
+                                                                  : embedded(m.occlusion_image, "image/png");
             gm.occlusionTexture.texCoord = m.occlusion_texcoord;
         }
         model.materials.push_back(gm);
