@@ -8,6 +8,8 @@
 #include <cstring>
 
 #include "common.h"
+#include "skybake/files.h"
+#include "skybake/gltf_asset.h"
 #include "skybake/mesh.h"
 
 namespace skybake::python {
@@ -162,6 +164,35 @@ void bind_mesh(py::module_& m) {
         },
         py::arg("path"), py::arg("mesh"), py::arg("ascii") = false,
         "Writes .glb (attributes as \"_NAME\") or .ply (ascii: text PLY). Atomic.");
+    py::class_<BakeFile>(
+        m, "BakeFile",
+        "A bake's mesh and the file it came from, written back through the one glTF path of the CLI: a glTF 2.0 "
+        "input keeps its whole document (materials, textures, nodes, skins, animations, extensions) and gains "
+        "the baked attributes; other inputs are written as a plain .glb or .ply.")
+        .def(py::init([](const std::filesystem::path& input, const std::filesystem::path& output) {
+                 return long_call(py::none(), [&] { return BakeFile::open(input, output); });
+             }),
+             py::arg("input"), py::arg("output"),
+             "Reads INPUT for a bake that will write OUTPUT (.glb, .gltf or .ply). Raises skybake.Error as "
+             "load_mesh() does, and for a .gltf output of an input that is not glTF 2.0.")
+        .def_property_readonly(
+            "mesh", [](BakeFile& f) -> Mesh& { return f.mesh(); }, py::return_value_policy::reference_internal,
+            "The mesh, in place: bake it (bake_ao, bake_transfer, ...) and its attributes are what save() writes.")
+        .def_property_readonly("has_document", [](BakeFile& f) { return f.document() != nullptr; },
+                               "Whether the input's glTF document is kept.")
+        .def(
+            "save",
+            [](const BakeFile& f, const std::filesystem::path& path, bool ascii) {
+                long_call(py::none(), [&] {
+                    OutputSet files;
+                    f.save(files.stage(path), ExportOptions{ascii ? PlyEncoding::Ascii : PlyEncoding::Binary});
+                    files.commit();
+                });
+            },
+            py::arg("path"), py::arg("ascii") = false,
+            "Writes the mesh with its attributes as `skybake ao` does (.glb, .gltf or .ply; ascii: text PLY). "
+            "Atomic.");
+
     m.def(
         "generate_mesh",
         [](const std::string& kind, std::uint64_t triangles, std::uint64_t seed) {

@@ -1,11 +1,13 @@
 // Precomputed radiance transfer: the transfer bake, SH lights (the sky, maps,
 // constants), relighting and the asset files (skybake/prt.h).
 #include <cstring>
+#include <functional>
 #include <optional>
 
 #include "common.h"
 #include "skybake/bake.h"
 #include "skybake/files.h"
+#include "skybake/gltf_asset.h"
 #include "skybake/prt.h"
 #include "skybake/sky_source.h"
 #include "skybake/bake_job.h"
@@ -191,25 +193,46 @@ void bind_prt(py::module_& m) {
         py::arg("mesh"), py::arg("direction"), py::arg("backend") = "embree",
         "Per-vertex visibility (V,) float32 of a direction (1 or 0), one occlusion ray per vertex.");
 
+    // As `skybake prt bake` writes its outputs: the attributes, COLOR_0 = the
+    // white-sky transfer where the mesh has no colours, the sidecar; both
+    // files or neither.
+    const auto write_prt = [](const std::filesystem::path& path, Mesh& mesh, const Transfer& transfer,
+                              const py::handle& albedo, const std::function<void(const std::filesystem::path&)>& save) {
+        const std::vector<glm::vec3> rho =
+            albedo.is_none() ? mesh_albedo(mesh) : albedo_arg(albedo, mesh.vertex_count());
+        const std::string source = !albedo.is_none() ? "array"
+                                   : !mesh.materials.empty() && !mesh.triangle_parts.empty()
+                                       ? "material"
+                                       : (mesh.colors.size() == mesh.vertex_count() ? "vertex-colors"
+                                                                                    : "[0.8, 0.8, 0.8]");
+        py::gil_scoped_release release;
+        const bool had_colors = mesh.colors.size() == mesh.vertex_count();
+        set_transfer_attributes(mesh, transfer, rho);
+        if (!had_colors)
+            set_white_sky_colors(mesh, transfer);
+        OutputSet files;
+        save(files.stage(path));
+        const std::string side = transfer_sidecar_json(transfer, mesh.vertex_count(), source, !had_colors);
+        write_stream_atomic(files.stage(prt_sidecar_path(path)), [&](std::ostream& out) { out << side; });
+        files.commit();
+    };
     m.def(
         "save_prt",
-        [](const std::filesystem::path& path, Mesh& mesh, const Transfer& transfer, const py::handle& albedo) {
-            const std::vector<glm::vec3> rho =
-                albedo.is_none() ? mesh_albedo(mesh) : albedo_arg(albedo, mesh.vertex_count());
-            const std::string source = albedo.is_none() && mesh.colors.size() == mesh.vertex_count()
-                                           ? "vertex-colors"
-                                           : "[0.8, 0.8, 0.8]";
-            py::gil_scoped_release release;
-            set_transfer_attributes(mesh, transfer, rho);
-            OutputSet files;
-            save_mesh(files.stage(path), mesh);
-            const std::string side = transfer_sidecar_json(transfer, mesh.vertex_count(), source);
-            write_stream_atomic(files.stage(prt_sidecar_path(path)), [&](std::ostream& out) { out << side; });
-            files.commit();
+        [write_prt](const std::filesystem::path& path, const py::object& mesh, const Transfer& transfer,
+                    const py::handle& albedo) {
+            if (py::isinstance<BakeFile>(mesh)) {
+                BakeFile& file = mesh.cast<BakeFile&>();
+                write_prt(path, file.mesh(), transfer, albedo,
+                          [&](const std::filesystem::path& tmp) { file.save(tmp); });
+                return;
+            }
+            Mesh& m = mesh.cast<Mesh&>();
+            write_prt(path, m, transfer, albedo, [&](const std::filesystem::path& tmp) { save_mesh(tmp, m); });
         },
         py::arg("path"), py::arg("mesh"), py::arg("transfer"), py::arg("albedo") = py::none(),
-        "Writes a baked mesh (.glb or .ply, attributes prt_0 ... and albedo) and its sidecar PATH.prt.json, "
-        "as `skybake prt bake` does; both or neither.");
+        "Writes a baked mesh (.glb or .ply: attributes prt_0 ..., albedo, and COLOR_0 = the vertex under a white "
+        "sky where the mesh has no colours) and its sidecar PATH.prt.json, as `skybake prt bake` does; both or "
+        "neither. With a BakeFile for `mesh`, a glTF 2.0 input keeps its whole document.");
     m.def(
         "load_prt",
         [](const std::filesystem::path& path) {

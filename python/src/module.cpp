@@ -49,6 +49,16 @@ bool on_main_thread() {
 
 } // namespace
 
+// A ProgressEvent that owns its strings, as Python sees it: a callback may
+// keep it after the operation (and the strings it viewed) has ended.
+struct OwnedProgressEvent {
+    std::string label;
+    std::uint64_t done = 0, total = 0;
+    double seconds = 0.0;
+    std::string status;
+    bool finished = false;
+};
+
 struct LongCall::SavedHandler {
     struct sigaction old;
 };
@@ -84,7 +94,10 @@ LongCall::LongCall(py::object progress) : progress_(std::move(progress)) {
         if (error_type_) // the callback raised already: the operation is unwinding
             throw Stopped();
         try {
-            py::reinterpret_borrow<py::object>(callable)(e);
+            // The event's strings view the operation's own; Python keeps a copy.
+            py::reinterpret_borrow<py::object>(callable)(OwnedProgressEvent{std::string(e.label), e.done, e.total,
+                                                                            e.seconds, std::string(e.status),
+                                                                            e.finished});
         } catch (py::error_already_set& err) {
             if (!error_type_) { // keep the first
                 error_type_ = err.type();
@@ -225,17 +238,18 @@ void bind_core(py::module_& m) {
           "The visibility backends of this build (embree, brute, raster, and cuda in CUDA builds), each with "
           "whether it can run on this machine (cuda: a GPU; raster: headless OpenGL 4.3).");
 
-    py::class_<ProgressEvent>(m, "ProgressEvent", "What a long call reports, at most every 100 ms and once at the end.")
-        .def_property_readonly("label", [](const ProgressEvent& e) { return std::string(e.label); })
-        .def_readonly("done", &ProgressEvent::done, "Units of work done.")
-        .def_readonly("total", &ProgressEvent::total, "Units of work in all (0: unknown).")
-        .def_readonly("seconds", &ProgressEvent::seconds, "Since the operation began.")
-        .def_property_readonly("status", [](const ProgressEvent& e) { return std::string(e.status); })
-        .def_readonly("finished", &ProgressEvent::finished)
-        .def_property_readonly("fraction",
-                               [](const ProgressEvent& e) { return e.total ? double(e.done) / double(e.total) : 0.0; })
-        .def("__repr__", [](const ProgressEvent& e) {
-            return "ProgressEvent(label='" + std::string(e.label) + "', done=" + std::to_string(e.done) +
+    py::class_<OwnedProgressEvent>(m, "ProgressEvent",
+                                   "What a long call reports, at most every 100 ms and once at the end.")
+        .def_readonly("label", &OwnedProgressEvent::label)
+        .def_readonly("done", &OwnedProgressEvent::done, "Units of work done.")
+        .def_readonly("total", &OwnedProgressEvent::total, "Units of work in all (0: unknown).")
+        .def_readonly("seconds", &OwnedProgressEvent::seconds, "Since the operation began.")
+        .def_readonly("status", &OwnedProgressEvent::status)
+        .def_readonly("finished", &OwnedProgressEvent::finished)
+        .def_property_readonly(
+            "fraction", [](const OwnedProgressEvent& e) { return e.total ? double(e.done) / double(e.total) : 0.0; })
+        .def("__repr__", [](const OwnedProgressEvent& e) {
+            return "ProgressEvent(label='" + e.label + "', done=" + std::to_string(e.done) +
                    ", total=" + std::to_string(e.total) + (e.finished ? ", finished=True)" : ")");
         });
 

@@ -1,6 +1,9 @@
 """Bakes through Python: closed forms, the CLI on the same mesh, the bits,
 progress, the GIL and Ctrl-C."""
+import json
 import os
+import pathlib
+import struct
 import signal
 import subprocess
 import sys
@@ -330,3 +333,50 @@ def test_one_job_the_cli_and_python_give_identical_bits(cli, tmp):
         "--quiet")
     mesh, transfer, albedo = skybake.load_prt(tmp / "prt.ply")
     np.testing.assert_array_equal(transfer.coeffs, t.coeffs)
+
+
+def glb_json(path):
+    data = pathlib.Path(path).read_bytes()
+    (length,) = struct.unpack_from("<I", data, 12)
+    return json.loads(data[20:20 + length])
+
+
+BOX = pathlib.Path("/usr/share/assimp/models/glTF2/BoxTextured-glTF/BoxTextured.gltf")
+
+
+@pytest.mark.skipif(not BOX.exists(), reason="assimp-testmodels is not installed")
+def test_bake_file_writes_what_the_cli_writes(cli, tmp):
+    """BakeFile keeps a glTF 2.0 document as `ao` and `prt bake` do: the same bytes, texture and nodes kept."""
+    cli("ao", BOX, "-o", tmp / "cli.glb", "--rule", "lebedev:50", "--quiet")
+    f = skybake.BakeFile(BOX, tmp / "py.glb")
+    assert f.has_document
+    skybake.bake_ao(f.mesh, rule="lebedev:50")
+    f.save(tmp / "py.glb")
+    assert (tmp / "py.glb").read_bytes() == (tmp / "cli.glb").read_bytes()
+    doc = glb_json(tmp / "py.glb")
+    assert doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["index"] == 0
+    assert "COLOR_0" in doc["meshes"][0]["primitives"][0]["attributes"]
+
+    cli("prt", "bake", BOX, "-o", tmp / "cli_prt.glb", "--rule", "lebedev:50", "--order", "2", "--quiet")
+    f = skybake.BakeFile(BOX, tmp / "py_prt.glb")
+    t = skybake.bake_transfer(f.mesh, rule="lebedev:50", order=2)
+    skybake.save_prt(tmp / "py_prt.glb", f, t)
+    assert (tmp / "py_prt.glb").read_bytes() == (tmp / "cli_prt.glb").read_bytes()
+    assert (tmp / "py_prt.prt.json").read_text() == (tmp / "cli_prt.prt.json").read_text()
+    mesh, transfer, _ = skybake.load_prt(tmp / "py_prt.glb")
+    np.testing.assert_array_equal(transfer.coeffs, t.coeffs)
+
+
+def test_bake_file_of_a_plain_mesh_and_its_errors(tmp):
+    m = skybake.generate_mesh("bowl", 500)
+    skybake.save_mesh(tmp / "bowl.ply", m)
+    f = skybake.BakeFile(tmp / "bowl.ply", tmp / "bowl.glb")
+    assert not f.has_document
+    assert f.mesh.vertex_count == m.vertex_count
+    skybake.bake_ao(f.mesh, rule="lebedev:50")
+    f.save(tmp / "bowl.glb")
+    assert skybake.load_mesh(tmp / "bowl.glb").attribute("ao").shape == (m.vertex_count,)
+    with pytest.raises(skybake.Error, match="gltf"):
+        skybake.BakeFile(tmp / "bowl.ply", tmp / "bowl.gltf")
+    with pytest.raises(skybake.Error):
+        skybake.BakeFile(tmp / "missing.glb", tmp / "x.glb")
