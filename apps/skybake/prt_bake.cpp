@@ -98,8 +98,12 @@ void run(const BakeOpts& o, const CLI::App& sub) {
     Mesh& mesh = file.mesh();
     const bool had_colors = mesh.colors.size() == mesh.vertex_count();
     test_fault_point("load");
-    bake.albedo =
-        constant_albedo ? std::vector<glm::vec3>(mesh.vertex_count(), albedo_value) : mesh_albedo(mesh, albedo_value);
+    // --albedo material: the images are decoded once, for the vertices and
+    // for the bounces' hits.
+    if (!constant_albedo)
+        bake.albedo_images = base_color_images(mesh);
+    bake.albedo = constant_albedo ? std::vector<glm::vec3>(mesh.vertex_count(), albedo_value)
+                                  : mesh_albedo(mesh, bake.albedo_images, albedo_value);
     const std::string albedo_source =
         constant_albedo ? fmt::format("[{}, {}, {}]", albedo_value.x, albedo_value.y, albedo_value.z)
                         : !mesh.materials.empty() && !mesh.triangle_parts.empty()
@@ -179,8 +183,8 @@ void add_prt_bake(CLI::App& group) {
         ->check(CLI::Range(8u, kRasterMaxResolution));
     sub->add_option("--albedo", o->albedo,
                     "The bounces' albedo: material (the default: the material's base colour factor x image x vertex "
-                    "colour, as glTF defines it, at each vertex; else the vertex colours; else 0.8), or a constant "
-                    "linear RGB reflectance, one or three numbers in [0, 1]");
+                    "colour, as glTF defines it, at each hit's UV; else the vertex colours; else 0.8), or a "
+                    "constant linear RGB reflectance, one or three numbers in [0, 1]");
     sub->add_option("--model", o->model,
                     "prt (the transfer integral) or shading-coefficient (the seed's A times the unshadowed "
                     "irradiance)")

@@ -47,6 +47,9 @@ struct BakeJob {
     std::optional<TransferOptions> transfer; // SH transfer per vertex, bounces included (bake_transfer())
     // The bounces' albedo, one per vertex; empty: mesh_albedo(mesh).
     std::vector<glm::vec3> albedo;
+    // The base colour images (base_color_images()): bounces off a textured
+    // material take the albedo at the hit's UV (bake_transfer()). Empty: per vertex only.
+    std::vector<Image> albedo_images;
     std::optional<TextureBakeOptions> texture; // AO at the texels of a UV layout (bake_ao_texture())
     // A preview image of the baked AO (render_ao_preview()), or of the
     // texture AO over base_colors (render_texture_preview()) with a texture.

@@ -157,12 +157,16 @@ struct TransferReport {
 // albedo: one linear RGB reflectance in [0, 1] per vertex (mesh.vertex_count()
 // entries), used by the bounces only (may be empty otherwise); queries: a
 // backend that answers ray queries, required for interreflected transfer
-// (nullptr otherwise). Computes normals when the mesh has none. Throws
-// skybake::Error naming the field: "order", "bounces", "kind", "albedo",
-// "backend" (bounces without ray queries), and those of bake_visibility().
+// (nullptr otherwise). With `images` (base_color_images(): glTF's --albedo
+// material), a bounce off a triangle whose material has an image takes the
+// albedo at the hit itself (surface_base_color(): the image at the hit's UV),
+// not the vertices' interpolated albedo. Computes normals when the mesh has
+// none. Throws skybake::Error naming the field: "order", "bounces", "kind",
+// "albedo", "backend" (bounces without ray queries), and those of
+// bake_visibility().
 TransferReport bake_transfer(Mesh& mesh, const SphereRule& rule, VisibilityTracer& tracer, const BakeOptions& bake,
                              const TransferOptions& options, std::span<const glm::vec3> albedo, RayQueries* queries,
-                             Transfer& out);
+                             Transfer& out, const std::vector<Image>& images = {});
 
 // The mesh's albedo for PRT, per vertex, as glTF defines the base colour:
 // the material's base colour factor × its base colour image (bilinear at the
@@ -184,6 +188,14 @@ std::vector<glm::vec3> mesh_albedo(const Mesh& mesh, const std::vector<Image>& i
 // Mesh::materials; an empty Image where a material has none or its file does
 // not load.
 std::vector<Image> base_color_images(const Mesh& mesh);
+
+// glTF's base colour at a point of triangle `triangle`, (u, v) the weights
+// of its second and third vertex: the material's factor × its image
+// (`images`, as base_color_images() decodes them) bilinear at the point's UV
+// × the interpolated vertex colour, clamped to [0, 1]. False, and `out` left
+// alone, where the triangle's material has no decoded image or no UVs.
+bool surface_base_color(const Mesh& mesh, const std::vector<Image>& images, std::uint32_t triangle, float u, float v,
+                        glm::vec3& out);
 
 // Each vertex's material (that of the first triangle using it), or -1.
 std::vector<int> vertex_materials(const Mesh& mesh);

@@ -81,7 +81,12 @@ void bind_prt(py::module_& m) {
             job.options = bake_options(max_distance, 0.0f, "occlude", false);
             job.shading = false;
             job.transfer = t;
-            job.albedo = albedo.is_none() ? mesh_albedo(mesh) : albedo_arg(albedo, mesh.vertex_count());
+            if (albedo.is_none()) { // glTF's base colour, at each hit as `prt bake --albedo material`
+                job.albedo_images = base_color_images(mesh);
+                job.albedo = mesh_albedo(mesh, job.albedo_images);
+            } else {
+                job.albedo = albedo_arg(albedo, mesh.vertex_count());
+            }
             job.tracer.device = device;
             job.tracer.backend = backend;
             job.tracer.method = method.value_or("");

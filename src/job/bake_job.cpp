@@ -131,7 +131,8 @@ BakeJobResult run_bake_job(Mesh& mesh, const BakeJob& job) {
         const std::vector<glm::vec3> albedo = job.albedo.empty() ? mesh_albedo(mesh) : job.albedo;
         BakeOptions t = options;
         t.store_bits = false;
-        r.transfer_report = bake_transfer(mesh, job.rule, tracer, t, *job.transfer, albedo, queries, r.transfer);
+        r.transfer_report = bake_transfer(mesh, job.rule, tracer, t, *job.transfer, albedo, queries, r.transfer,
+                                          job.albedo_images);
     }
     if (job.preview) {
         AoPreviewOptions p = *job.preview;

@@ -53,6 +53,34 @@ std::vector<int> vertex_materials(const Mesh& mesh) {
     return material;
 }
 
+bool surface_base_color(const Mesh& mesh, const std::vector<Image>& images, std::uint32_t triangle, float u, float v,
+                        glm::vec3& out) {
+    if (triangle >= mesh.triangle_count() || mesh.triangle_parts.size() != mesh.triangle_count())
+        return false;
+    const std::uint32_t part = mesh.triangle_parts[triangle];
+    const int m = part < mesh.parts.size() ? mesh.parts[part].material : -1;
+    if (m < 0 || std::size_t(m) >= mesh.materials.size() || std::size_t(m) >= images.size())
+        return false;
+    const Image& img = images[std::size_t(m)];
+    const MeshMaterial& mm = mesh.materials[std::size_t(m)];
+    const auto set = std::size_t(std::max(mm.base_color_texcoord, 0));
+    const std::size_t n = mesh.vertex_count();
+    if (img.width <= 0 || img.height <= 0 || set >= mesh.texcoords.size() || mesh.texcoords[set].size() != n)
+        return false;
+    const std::uint32_t* t = &mesh.indices[3 * std::size_t(triangle)];
+    const float w[3] = {1.0f - u - v, u, v};
+    glm::vec2 uv(0.0f);
+    glm::vec3 colour(0.0f);
+    for (int k = 0; k < 3; ++k) {
+        uv += w[k] * mesh.texcoords[set][t[k]];
+        colour += w[k] * (mesh.colors.size() == n ? glm::vec3(mesh.colors[t[k]]) : glm::vec3(1.0f));
+    }
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y) || std::abs(uv.x) >= 1e6f || std::abs(uv.y) >= 1e6f)
+        return false;
+    out = glm::clamp(glm::vec3(mm.base_color) * sample_bilinear(img, uv) * colour, glm::vec3(0.0f), glm::vec3(1.0f));
+    return true;
+}
+
 std::vector<Image> base_color_images(const Mesh& mesh) {
     std::vector<Image> images(mesh.materials.size());
     for (std::size_t m = 0; m < mesh.materials.size(); ++m) {

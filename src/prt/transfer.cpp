@@ -126,8 +126,8 @@ namespace {
 // Sloan 2002, section 5: each bounce gathers, along every occluded rule
 // direction, the transfer of the closest hit (interpolated, times its albedo).
 void add_bounces(const Mesh& mesh, const SphereRule& rule, const BakeOptions& bake, const TransferReduction& red,
-                 std::span<const glm::vec3> albedo, RayQueries& queries, int bounces, Transfer& out,
-                 TransferReport& report) {
+                 std::span<const glm::vec3> albedo, const std::vector<Image>& images, RayQueries& queries,
+                 int bounces, Transfer& out, TransferReport& report) {
     const std::size_t n = mesh.vertex_count();
     const int nc = out.coefficients;
 
@@ -136,14 +136,20 @@ void add_bounces(const Mesh& mesh, const SphereRule& rule, const BakeOptions& ba
     struct Gather {
         std::uint32_t vertex, triangle;
         float weight, u, v; // weight: w_k 4 (n·x_k)
+        bool at_hit;        // rho is the albedo at the hit (a material's image), else the corners' albedo
+        glm::vec3 rho;
     };
     std::vector<Gather> gathers;
     {
         const std::vector<BlockedDirection> blocked = blocked_directions(mesh, rule, bake, red.words(), queries);
         report.bounce_rays = blocked.size(); // traced once, gathered by every bounce
         gathers.reserve(blocked.size());
-        for (const BlockedDirection& b : blocked)
-            gathers.push_back({b.vertex, b.hit.triangle, 4.0f * b.weight * b.cosine, b.hit.u, b.hit.v});
+        for (const BlockedDirection& b : blocked) {
+            Gather g{b.vertex, b.hit.triangle, 4.0f * b.weight * b.cosine, b.hit.u, b.hit.v, false, glm::vec3(0.0f)};
+            if (!images.empty() && g.triangle != kNoHit)
+                g.at_hit = surface_base_color(mesh, images, g.triangle, g.u, g.v, g.rho);
+            gathers.push_back(g);
+        }
     }
     // Gathers are grouped by vertex (pushed in vertex order).
     std::vector<std::size_t> start(n + 1, 0);
@@ -175,7 +181,8 @@ void add_bounces(const Mesh& mesh, const SphereRule& rule, const BakeOptions& ba
                     const float bw[3] = {1.0f - ga.u - ga.v, ga.u, ga.v};
                     for (int corner = 0; corner < 3; ++corner) {
                         const std::size_t h = tri[corner];
-                        const glm::vec3 rho = albedo[h] * (ga.weight * bw[corner]);
+                        const glm::vec3 rho =
+                            ga.at_hit ? ga.rho * (ga.weight * bw[corner]) : albedo[h] * (ga.weight * bw[corner]);
                         for (int ch = 0; ch < 3; ++ch) {
                             const float* src = previous.data() + (h * 3 + std::size_t(ch)) * std::size_t(nc);
                             float* dst = t + std::size_t(ch) * std::size_t(nc);
@@ -198,7 +205,7 @@ void add_bounces(const Mesh& mesh, const SphereRule& rule, const BakeOptions& ba
 
 TransferReport bake_transfer(Mesh& mesh, const SphereRule& rule, VisibilityTracer& tracer, const BakeOptions& bake,
                              const TransferOptions& options, std::span<const glm::vec3> albedo, RayQueries* queries,
-                             Transfer& out) {
+                             Transfer& out, const std::vector<Image>& images) {
     const auto t0 = std::chrono::steady_clock::now();
     if (options.order < 0 || options.order > kPrtMaxOrder)
         throw Error(fmt::format("SH order must be 0 to {} (at most {} coefficients); got {}", kPrtMaxOrder,
@@ -266,7 +273,7 @@ TransferReport bake_transfer(Mesh& mesh, const SphereRule& rule, VisibilityTrace
     if (bounce) {
         const auto tb = std::chrono::steady_clock::now();
         queries->set_mesh(mesh, bake.back_faces);
-        add_bounces(mesh, rule, bake, reduction, albedo, *queries, options.bounces, out, r);
+        add_bounces(mesh, rule, bake, reduction, albedo, images, *queries, options.bounces, out, r);
         r.bounce_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - tb).count();
     }
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

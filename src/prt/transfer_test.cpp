@@ -4,6 +4,7 @@
 //  - unshadowed transfer of an SH light = Ramamoorthi & Hanrahan's irradiance
 //    convolution, (Â_l / π) L_lm Y_lm(n);
 //  - bounces: each bounce adds at most albedo_max times the previous one.
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -11,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "skybake/error.h"
+#include "skybake/image.h"
 #include "skybake/prt.h"
 
 namespace skybake {
@@ -237,6 +239,58 @@ TEST(Transfer, BowlConvergesToTheInfiniteBounceLimit) {
         EXPECT_NEAR(mean / double(count) / want, 1.0, 1e-3) << n;
         EXPECT_LT(worst, 0.05) << n;
     }
+}
+
+// The bowl again, its albedo in a material's image (0.6) and wrong per
+// vertex (0.2): the bounces read the image where they land, so the closed
+// form of ρ = 0.6 holds; per vertex it would be far off.
+TEST(Transfer, BouncesReadTheMaterialImageAtTheHit) {
+    ProceduralOptions p;
+    p.kind = ProceduralKind::Bowl;
+    p.target_triangles = 4000;
+    Mesh mesh = generate_mesh(p);
+    compute_normals(mesh);
+    mesh.materials.resize(1);
+    mesh.materials[0].base_color = glm::vec4(1.0f);
+    mesh.parts.assign(1, MeshPart{"bowl", 0});
+    mesh.triangle_parts.assign(mesh.triangle_count(), 0);
+    mesh.texcoords.assign(1, std::vector<glm::vec2>(mesh.vertex_count()));
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        mesh.texcoords[0][v] = glm::vec2(3.1f * mesh.positions[v].x, 2.7f * mesh.positions[v].z);
+    const float rho = 0.6f;
+    Image image(3, 2);
+    std::fill(image.rgb.begin(), image.rgb.end(), rho);
+    const std::vector<Image> images{image};
+    glm::vec3 at;
+    ASSERT_TRUE(surface_base_color(mesh, images, 7, 0.2f, 0.3f, at));
+    EXPECT_EQ(at, glm::vec3(rho));
+    EXPECT_FALSE(surface_base_color(mesh, {}, 7, 0.2f, 0.3f, at)) << "no image: the vertices' albedo";
+
+    const SphereRule rule = parse_rule("lebedev:1202");
+    const auto tracer = make_visibility_tracer("embree");
+    const auto queries = make_ray_queries("embree");
+    const std::vector<glm::vec3> wrong(mesh.vertex_count(), glm::vec3(0.2f)), right(mesh.vertex_count(), glm::vec3(rho));
+    TransferOptions o;
+    o.order = 0;
+    o.kind = TransferKind::Interreflected;
+    o.bounces = 3;
+    Transfer t;
+    bake_transfer(mesh, rule, *tracer, BakeOptions{}, o, wrong, queries.get(), t, images);
+    const std::vector<glm::vec3> b = relight(t, constant_light(glm::vec3(1.0f), 0), right);
+    const double f = 0.5;
+    double want = 0.0;
+    for (int k = 0; k <= o.bounces; ++k)
+        want += rho * f * std::pow(rho * (1.0 - f), k);
+    double mean = 0.0;
+    std::size_t count = 0;
+    for (std::size_t v = 0; v < b.size(); ++v)
+        if (mesh.positions[v].y < -0.3f) {
+            mean += double(b[v].x);
+            ++count;
+        }
+    ASSERT_GT(count, 100u);
+    std::printf("bowl, albedo from the image at the hits: closed form %.5f, mean %.5f\n", want, mean / double(count));
+    EXPECT_NEAR(mean / double(count) / want, 1.0, 1e-3);
 }
 
 TEST(Transfer, ConvexSphereHasNoBounces) {
