@@ -6,10 +6,17 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/shared_source.h"
 #include "skybake/error.h"
 #include "skybake/names.h"
 
 namespace skybake {
+
+namespace tone {
+#include "core/tone_curve.h" // shared with the renderers' GLSL tone pass
+} // namespace tone
+static_assert(int(ToneCurve::Clamp) == tone::kToneClamp && int(ToneCurve::Reinhard) == tone::kToneReinhard &&
+              int(ToneCurve::Aces) == tone::kToneAces);
 
 namespace {
 constexpr NamedValue<ToneCurve> kToneCurveNames[] = {
@@ -21,20 +28,10 @@ ToneCurve parse_tone_curve(const std::string& name) { return parse_name(kToneCur
 float tone_map_value(float linear, const ToneMap& tm) {
     if (!std::isfinite(linear) || linear <= 0.0f)
         return linear > 0.0f ? 1.0f : 0.0f; // +inf -> white, NaN/negative -> black
-    const float x = linear * std::exp2(tm.exposure_ev);
-    float y = x;
-    switch (tm.curve) {
-    case ToneCurve::Clamp: y = x; break;
-    case ToneCurve::Reinhard: y = x / (1.0f + x); break;
-    case ToneCurve::Aces: y = (x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f); break;
-    }
-    return std::clamp(y, 0.0f, 1.0f);
+    return tone::tone_curve(int(tm.curve), linear * std::exp2(tm.exposure_ev));
 }
 
-float linear_to_srgb(float v) {
-    v = std::clamp(v, 0.0f, 1.0f);
-    return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-}
+float linear_to_srgb(float v) { return tone::srgb_encode(v); }
 
 float srgb_to_linear(float v) {
     v = std::clamp(v, 0.0f, 1.0f);

@@ -511,7 +511,8 @@ std::unique_ptr<ModelRenderer::Impl> make_impl(const ViewerModel& model, const S
     }
     auto stage = [&](const std::string& body, const char* name) {
         ShaderSource s;
-        s.pieces = {kVersion, defines, fmt::format("#define {}\n", name), body, render::shaders::model_stages};
+        s.pieces = {kVersion,      defines, fmt::format("#define {}\n", name), render::shaders::shared_source,
+                    render::shaders::tone_curve, body, render::shaders::model_stages, render::shaders::screen_stages};
         return s;
     };
     m.model_program = link_program("model", stage(prt, "SKYBAKE_STAGE_MODEL_VS"), stage("", "SKYBAKE_STAGE_MODEL_FS"));
@@ -531,13 +532,13 @@ std::unique_ptr<ModelRenderer::Impl> make_impl(const ViewerModel& model, const S
         m.weights = make_buffer();
         glBindBuffer(GL_UNIFORM_BUFFER, m.weights.get());
         glBufferData(GL_UNIFORM_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
-        m.background_program = link_program("background", stage("", "SKYBAKE_STAGE_BACKGROUND_VS"),
+        m.background_program = link_program("background", stage("", "SKYBAKE_STAGE_FULL_SCREEN_VS"),
                                             stage(network, "SKYBAKE_STAGE_BACKGROUND_FS"));
         const GLuint block = glGetUniformBlockIndex(m.background_program.get(), "SkybakeSkyWeights");
         if (block != GL_INVALID_INDEX)
             glUniformBlockBinding(m.background_program.get(), block, 0);
     } else {
-        m.map_background_program = link_program("background", stage("", "SKYBAKE_STAGE_BACKGROUND_VS"),
+        m.map_background_program = link_program("background", stage("", "SKYBAKE_STAGE_FULL_SCREEN_VS"),
                                                 stage("", "SKYBAKE_STAGE_BACKGROUND_MAP_FS"));
     }
 

@@ -61,9 +61,12 @@ ShaderSource stage(const std::string& defines, const std::string& network, const
     s.pieces = {kVersion,
                 defines,
                 fmt::format("#define {}\n", stage_define),
+                shaders::shared_source,
+                shaders::tone_curve,
                 network,
                 shaders::atmosphere,
-                shaders::planet_stages};
+                shaders::planet_stages,
+                shaders::screen_stages};
     if (const char* bad = std::getenv("SKYBAKE_GL_TEST_BAD_SHADER"); bad && *bad == '1')
         s.pieces.push_back("this is not GLSL;\n"); // test hook: a shader that fails to compile
     return s;
@@ -110,13 +113,14 @@ PlanetScene::PlanetScene(const GlContext& context, const SkyModel& model, const 
         glBindBuffer(GL_UNIFORM_BUFFER, weights_.get());
         glBufferData(GL_UNIFORM_BUFFER, GLsizeiptr(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
     }
-    sky_ = link_program("sky", stage(defines, network, "SKYBAKE_STAGE_SKY_VS"),
+    const char* sky_vs = options.shading == ShadingRate::Pixel ? "SKYBAKE_STAGE_FULL_SCREEN_VS" : "SKYBAKE_STAGE_SKY_VS";
+    sky_ = link_program("sky", stage(defines, network, sky_vs),
                         stage(defines, network, "SKYBAKE_STAGE_SKY_FS"));
     planet_ = link_program("planet", stage(defines, network, "SKYBAKE_STAGE_PLANET_VS"),
                            stage(defines, network, "SKYBAKE_STAGE_PLANET_FS"));
     flat_ = link_program("flat", stage(defines, network, "SKYBAKE_STAGE_FLAT_VS"),
                          stage(defines, network, "SKYBAKE_STAGE_FLAT_FS"));
-    tone_ = link_program("tone", stage(defines, network, "SKYBAKE_STAGE_TONE_VS"),
+    tone_ = link_program("tone", stage(defines, network, "SKYBAKE_STAGE_FULL_SCREEN_VS"),
                          stage(defines, network, "SKYBAKE_STAGE_TONE_FS"));
     for (GLuint p : {sky_.get(), planet_.get()}) {
         const GLuint block = glGetUniformBlockIndex(p, "SkybakeSkyWeights");
@@ -479,7 +483,7 @@ void PlanetScene::tone_map(GLuint texture, int width, int height, float exposure
     glBindTexture(GL_TEXTURE_2D, texture);
     glUniform1i(loc(tone_.get(), "u_image"), 1);
     glUniform1f(loc(tone_.get(), "u_exposure_scale"), std::exp2(exposure_ev));
-    glUniform1i(loc(tone_.get(), "u_tone"), curve == ToneCurve::Clamp ? 0 : curve == ToneCurve::Reinhard ? 1 : 2);
+    glUniform1i(loc(tone_.get(), "u_tone"), int(curve)); // tone_curve()'s values (core/tone_curve.h)
     glBindVertexArray(empty_vao_.get());
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glBindVertexArray(0);

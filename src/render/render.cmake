@@ -1,6 +1,7 @@
 # The planet renderer and the viewer (src/render/), on the OpenGL layer (src/gl/).
 # GLSL sources are embedded as C++ string literals: src/render/shaders/NAME.glsl
-# becomes the constant skybake::render::shaders::NAME in render/shaders.h.
+# becomes the constant skybake::render::shaders::NAME in render/shaders.h, and
+# so does each file shared by C++ and GLSL (SHARED, see core/shared_source.h).
 #
 # The window (GLFW and Dear ImGui) is optional: without glfw3 or imgui, or
 # without the sources of Dear ImGui's GLFW and OpenGL 3 backends (Debian's
@@ -34,4 +35,5 @@ else()
   skybake_add_module(render DEPENDS core io gl sphere visibility bake sky neural prt planet LIBS fmt::fmt)
 endif()
 skybake_embed_glsl(TARGET skybake_render DIR ${CMAKE_CURRENT_SOURCE_DIR}/render/shaders
-  HEADER render/shaders.h NAMESPACE skybake::render::shaders)
+  HEADER render/shaders.h NAMESPACE skybake::render::shaders
+  SHARED ${CMAKE_CURRENT_SOURCE_DIR}/core/tone_curve.h)

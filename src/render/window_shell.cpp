@@ -205,10 +205,11 @@ void OrbitCamera::reset() {
 ToneMapper::ToneMapper() {
     auto stage = [](const char* name) {
         gl::ShaderSource s;
-        s.pieces = {"#version 330 core\n", std::string("#define ") + name + "\n", shaders::model_stages};
+        s.pieces = {"#version 330 core\n", std::string("#define ") + name + "\n", shaders::shared_source,
+                    shaders::tone_curve, shaders::screen_stages};
         return s;
     };
-    program_ = gl::link_program("tone", stage("SKYBAKE_STAGE_TONE_VS"), stage("SKYBAKE_STAGE_TONE_FS"));
+    program_ = gl::link_program("tone", stage("SKYBAKE_STAGE_FULL_SCREEN_VS"), stage("SKYBAKE_STAGE_TONE_FS"));
     vao_ = gl::make_vertex_array();
 }
 
@@ -222,6 +223,7 @@ void ToneMapper::draw(unsigned texture, int width, int height, float exposure_ev
     glBindTexture(GL_TEXTURE_2D, texture);
     glUniform1i(glGetUniformLocation(p, "u_image"), 0);
     glUniform1f(glGetUniformLocation(p, "u_exposure_scale"), std::exp2(exposure_ev));
+    glUniform1i(glGetUniformLocation(p, "u_tone"), int(ToneCurve::Aces));
     glUniform2i(glGetUniformLocation(p, "u_offset"), 0, 0);
     glBindVertexArray(vao_.get());
     glDrawArrays(GL_TRIANGLES, 0, 3);

@@ -1,7 +1,9 @@
 // GLSL twin of src/sky/sky_hd.h and src/sky/render_hd.h (the sky model's
 // per-sample maths and the per-ray shading of src/neural/render_hd.h),
 // function for function and in the same order of operations; the tests
-// compare its images with the C++ renderer's.
+// compare its images with the C++ renderer's. Still kept by hand: the tone
+// curve has moved to core/tone_curve.h, one source for C++ and GLSL, and
+// these functions are to follow it (CONTRIBUTING.md, "Layout").
 //
 // Nishita T. et al. Display of the Earth Taking into Account Atmospheric
 // Scattering. SIGGRAPH 1993. Pietras & Rudnicki (seed 000), sections I
@@ -474,19 +476,3 @@ vec3 sb_shade_ground(vec3 d, vec3 g, vec3 nrm, float h_g, float dist) {
     return c;
 }
 
-// ---- tone curve (skybake::tone_map_value, ToneCurve::Aces, and linear_to_srgb) ----------
-uniform float u_exposure_scale; // 2^exposure_ev
-uniform int u_tone;             // 0 clamp, 1 reinhard, 2 aces
-
-float sb_tone(float v) {
-    if (!(v > 0.0))
-        return 0.0;
-    float x = v * u_exposure_scale;
-    float y = x;
-    if (u_tone == 1)
-        y = x / (1.0 + x);
-    else if (u_tone == 2)
-        y = (x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14);
-    y = clamp(y, 0.0, 1.0);
-    return y <= 0.0031308 ? 12.92 * y : 1.055 * pow(y, 1.0 / 2.4) - 0.055;
-}

@@ -1,11 +1,11 @@
 // Stage bodies of the model viewer, one per SKYBAKE_STAGE_* define:
-//   BACKGROUND_VS / BACKGROUND_FS  the sky network per pixel (full-screen triangle),
+//   BACKGROUND_FS                  the sky network per pixel,
 //   BACKGROUND_MAP_FS              the reference sky's map (relative azimuth × zenith angle) per pixel,
 //   MODEL_VS / MODEL_FS            the model: relight() of skybake/prt.h per vertex,
 //                                  the sun per pixel (shadow map) and the DPRT glossy layer,
 //   FLAT_VS / FLAT_FS              the same mesh in one constant colour (baseline),
 //   DEPTH_FS                       depth only (the shadow map, with FLAT_VS),
-//   TONE_VS / TONE_FS              exposure and ACES tone mapping of a linear target (the window).
+// The backgrounds' vertex stage and the window's tone pass are screen_stages.glsl's.
 // Before this text: the network's GLSL (skybake_sky) with SKYBAKE_NETWORK, and
 // export_prt_glsl()'s skybake_prt_diffuse with SKYBAKE_PRT_ATTRIBUTES and
 // SKYBAKE_SH_COUNT defined.
@@ -16,12 +16,7 @@ vec2 sb_equirect_uv(vec3 d) {
     return vec2(atan(d.x, d.z) * 0.159154943 + 0.5, acos(clamp(d.y, -1.0, 1.0)) * 0.318309886);
 }
 
-#if defined(SKYBAKE_STAGE_BACKGROUND_VS)
-void main() {
-    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-#elif defined(SKYBAKE_STAGE_BACKGROUND_FS)
+#if defined(SKYBAKE_STAGE_BACKGROUND_FS)
 uniform vec3 u_forward; // camera basis of preview_camera()
 uniform vec3 u_right;
 uniform vec3 u_up;
@@ -169,26 +164,4 @@ void main() {
 }
 #elif defined(SKYBAKE_STAGE_DEPTH_FS)
 void main() {}
-#elif defined(SKYBAKE_STAGE_TONE_VS)
-void main() {
-    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-#elif defined(SKYBAKE_STAGE_TONE_FS)
-// save_image()'s ToneCurve::Aces (Narkowicz's fit) and the sRGB encoding.
-uniform sampler2D u_image;
-uniform float u_exposure_scale; // 2^exposure
-uniform ivec2 u_offset;         // of the image in the window, pixels
-out vec4 o_colour;
-float sb_aces_srgb(float v) {
-    if (!(v > 0.0))
-        return 0.0;
-    float x = v * u_exposure_scale;
-    float y = clamp((x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
-    return y <= 0.0031308 ? 12.92 * y : 1.055 * pow(y, 1.0 / 2.4) - 0.055;
-}
-void main() {
-    vec3 c = texelFetch(u_image, ivec2(gl_FragCoord.xy) - u_offset, 0).rgb;
-    o_colour = vec4(sb_aces_srgb(c.r), sb_aces_srgb(c.g), sb_aces_srgb(c.b), 1.0);
-}
 #endif

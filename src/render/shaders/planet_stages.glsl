@@ -1,9 +1,10 @@
 // Stage bodies of the planet renderer, one per SKYBAKE_STAGE_* define:
-//   SKY_VS / SKY_FS       sky shell: per-vertex dome or per-pixel full-screen pass,
+//   SKY_VS / SKY_FS       sky shell: per-vertex dome and shell, or (FS) the per-pixel pass,
 //   PLANET_VS / PLANET_FS the planet mesh (camera-relative positions, km),
 //   FLAT_VS / FLAT_FS     a flat-shaded baseline over the same mesh,
-//   TONE_VS / TONE_FS     tone mapping of a linear float target for a window.
-// SKYBAKE_PER_PIXEL selects where the sky function runs.
+// SKYBAKE_PER_PIXEL selects where the sky function runs; per pixel, the sky
+// program's vertex stage is screen_stages.glsl's FULL_SCREEN_VS, as is the
+// tone pass's, whose TONE_FS is there too.
 
 uniform mat4 u_view_proj;     // camera-relative world -> clip (rotation and projection only)
 uniform vec3 u_forward;       // camera basis (pinhole of sky::pixel_direction)
@@ -20,13 +21,6 @@ vec3 sb_add_sun(vec3 d, vec3 sun_t) {
 }
 
 #if defined(SKYBAKE_STAGE_SKY_VS)
-#ifdef SKYBAKE_PER_PIXEL
-void main() {
-    // One triangle covering the viewport.
-    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-#else
 // Per vertex, two shells. Inside the atmosphere: a sphere of directions
 // around the eye (a_pos is a unit direction). Outside: the top of the
 // atmosphere as a mesh (a_pos relative to the eye, km), whose vertices crowd
@@ -59,7 +53,6 @@ void main() {
     vec4 c = u_view_proj * vec4(a_pos, u_shell == 0 ? 0.0 : 1.0);
     gl_Position = vec4(c.xy, 0.0, c.w);
 }
-#endif
 #elif defined(SKYBAKE_STAGE_SKY_FS)
 out vec4 o_colour;
 #ifdef SKYBAKE_PER_PIXEL
@@ -142,16 +135,4 @@ in vec3 v_normal;
 out vec4 o_colour;
 void main() { o_colour = vec4(vec3(max(dot(normalize(v_normal), u_sun), 0.0)), 1.0); }
 
-#elif defined(SKYBAKE_STAGE_TONE_VS)
-void main() {
-    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
-    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-#elif defined(SKYBAKE_STAGE_TONE_FS)
-uniform sampler2D u_image;
-out vec4 o_colour;
-void main() {
-    vec3 c = texelFetch(u_image, ivec2(gl_FragCoord.xy), 0).rgb;
-    o_colour = vec4(sb_tone(c.r), sb_tone(c.g), sb_tone(c.b), 1.0);
-}
 #endif
