@@ -18,7 +18,8 @@ function(skybake_embed_glsl)
     COMMAND ${CMAKE_COMMAND} -DOUT=${out} -DDIR=${E_DIR} -DNAMESPACE=${E_NAMESPACE} "-DSHARED=${shared}"
             -P ${PROJECT_SOURCE_DIR}/cmake/embed_glsl.cmake
     DEPENDS ${glsl} ${E_SHARED} ${PROJECT_SOURCE_DIR}/cmake/embed_glsl.cmake
-    COMMENT "Embedding GLSL shaders of ${E_TARGET}")
+    COMMENT "Embedding GLSL shaders of ${E_TARGET}"
+    VERBATIM)
   add_custom_target(${E_TARGET}_shaders DEPENDS ${out})
   add_dependencies(${E_TARGET} ${E_TARGET}_shaders)
   target_include_directories(${E_TARGET} PRIVATE ${PROJECT_BINARY_DIR}/include)

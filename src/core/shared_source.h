@@ -20,4 +20,6 @@
 #define SB_IN(T) const T&
 #define SB_OUT(T) T&
 #define SB_INOUT(T) T&
+// A struct member's default value: SB_INIT(x) is " = x" in C++, nothing in GLSL.
+#define SB_INIT(x) = x
 // The C maths names (expf, sqrtf, powf, ...) are the shared spelling; GLSL maps them to its own.

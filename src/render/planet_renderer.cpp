@@ -65,6 +65,9 @@ ShaderSource stage(const std::string& defines, const std::string& network, const
                 shaders::tone_curve,
                 network,
                 shaders::atmosphere,
+                shaders::grid4_shared,
+                shaders::sky_shared,
+                shaders::shade_shared,
                 shaders::planet_stages,
                 shaders::screen_stages};
     if (const char* bad = std::getenv("SKYBAKE_GL_TEST_BAD_SHADER"); bad && *bad == '1')
@@ -248,59 +251,83 @@ PlanetScene::~PlanetScene() = default;
 void PlanetScene::set_uniforms(GLuint p, const PlanetView& v, const Basis& b) const {
     glUseProgram(p);
     const Atmosphere& atm = model_.atmosphere();
-    const sky::AtmosphereHD a = sky::make_atmosphere_hd(atm, model_.tables());
-    glUniform1i(loc(p, "u_count"), a.count);
-    glUniform1f(loc(p, "u_R0"), a.R0);
-    glUniform1f(loc(p, "u_Rtop"), a.Rtop);
+    // u_render mirrors sky::RenderHD (sky/shade_shared.h) field by field, with
+    // the data handles as texture rows and texel offsets.
+    sky::RenderHD r;
+    r.atm = sky::atmosphere_hd(model_);
+    const glm::dvec3 eye = shading_eye(v);
+    const double eye_r = glm::length(eye);
+    r.eye_r = float(eye_r);
+    r.eye_h = float(eye_r - atm.planet_radius_km);
+    r.zenith = glm::vec3(eye / eye_r);
+    r.sun = glm::normalize(glm::vec3(v.sun));
+    r.steps = model_.options().steps;
+    r.spacing = model_.options().uniform_steps ? sky::kStepsUniform : sky::kStepsGraded;
+    r.albedo = glm::vec3(atm.ground_albedo);
+    r.published_ground = options_.published_ground ? 1 : 0;
+    r.irradiance = glm::vec3(atm.sun_irradiance);
+    r.sun_cos_radius = float(std::cos(atm.sun_angular_radius_rad));
+    r.sun_disc_radiance =
+        options_.sun_disc
+            ? float(1.0 / (3.14159265358979323846 * atm.sun_angular_radius_rad * atm.sun_angular_radius_rad))
+            : 0.0f;
+    const auto u1i = [&](const std::string& n, int x) { glUniform1i(loc(p, ("u_render." + n).c_str()), x); };
+    const auto u1f = [&](const std::string& n, float x) { glUniform1f(loc(p, ("u_render." + n).c_str()), x); };
+    const auto u3f = [&](const std::string& n, const glm::vec3& x) {
+        glUniform3f(loc(p, ("u_render." + n).c_str()), x.x, x.y, x.z);
+    };
+    const sky::AtmosphereHD& a = r.atm;
+    u1f("atm.R0", a.R0);
+    u1f("atm.Rtop", a.Rtop);
+    u1i("atm.count", a.count);
     for (int k = 0; k < a.count; ++k) {
         const sky::ComponentHD& c = a.comp[k];
-        auto name = [&](const char* n) { return fmt::format("{}[{}]", n, k); };
-        glUniform1i(loc(p, name("u_profile").c_str()), c.profile);
-        glUniform1f(loc(p, name("u_inv_scale_height").c_str()), c.inv_scale_height);
-        glUniform1f(loc(p, name("u_tent_center").c_str()), c.tent_center);
-        glUniform1f(loc(p, name("u_inv_tent_half_width").c_str()), c.inv_tent_half_width);
-        glUniform3f(loc(p, name("u_sca").c_str()), c.sca.x, c.sca.y, c.sca.z);
-        glUniform3f(loc(p, name("u_ext").c_str()), c.ext.x, c.ext.y, c.ext.z);
-        glUniform1i(loc(p, name("u_phase").c_str()), c.phase);
-        glUniform1f(loc(p, name("u_g").c_str()), c.g);
-        glUniform1i(loc(p, name("u_axis").c_str()), c.axis);
+        const std::string n = fmt::format("atm.comp[{}].", k);
+        u1i(n + "profile", c.profile);
+        u1f(n + "inv_scale_height", c.inv_scale_height);
+        u1f(n + "tent_center", c.tent_center);
+        u1f(n + "inv_tent_half_width", c.inv_tent_half_width);
+        u3f(n + "sca", c.sca);
+        u3f(n + "ext", c.ext);
+        u1i(n + "phase", c.phase);
+        u1f(n + "g", c.g);
+        u1i(n + "axis", c.axis);
+        u1i(n + "table.L", k * rows_);
+        u1i(n + "table.rows", rows_);
+        u1i(n + "table.cols", cols_);
     }
+    const sky::MultipleHD& m = a.ms;
+    u1i("atm.ms.method", m.method);
+    u1f("atm.ms.mu_s_min", m.mu_s_min);
+    u1i("atm.ms.orders", 0);
+    u1i("atm.ms.nr", m.nr);
+    u1i("atm.ms.nmu", m.nmu);
+    u1i("atm.ms.nmus", m.nmus);
+    u1i("atm.ms.nnu", m.nnu);
+    u1i("atm.ms.psi", ms_psi_first_);
+    u1i("atm.ms.psi_nr", m.psi ? m.psi_nr : 0);
+    u1i("atm.ms.psi_nmus", m.psi ? m.psi_nmus : 0);
+    u1i("atm.ms.irradiance", ms_irr_first_);
+    u1i("atm.ms.irr_nr", m.irradiance ? m.irr_nr : 0);
+    u1i("atm.ms.irr_nmus", m.irradiance ? m.irr_nmus : 0);
+    u1f("eye_r", r.eye_r);
+    u1f("eye_h", r.eye_h);
+    u3f("zenith", r.zenith);
+    u3f("sun", r.sun);
+    u1i("steps", r.steps);
+    u1i("spacing", r.spacing);
+    u3f("albedo", r.albedo);
+    u1i("published_ground", r.published_ground);
+    u3f("irradiance", r.irradiance);
+    u1f("sun_cos_radius", r.sun_cos_radius);
+    u1f("sun_disc_radiance", r.sun_disc_radiance);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, tables_.get());
     glUniform1i(loc(p, "u_tables"), 0);
-    glUniform1i(loc(p, "u_rows"), rows_);
-    glUniform1i(loc(p, "u_cols"), cols_);
-    {
-        const sky::MultipleHD& m = sky::atmosphere_hd(model_).ms;
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_BUFFER, ms_tex_.get());
-        glActiveTexture(GL_TEXTURE0);
-        glUniform1i(loc(p, "u_ms"), 1);
-        glUniform1i(loc(p, "u_ms_method"), m.method);
-        glUniform4i(loc(p, "u_ms_grid"), m.nr, m.nmu, m.nmus, m.nnu);
-        glUniform1f(loc(p, "u_ms_mu_s_min"), m.mu_s_min);
-        glUniform3i(loc(p, "u_ms_psi"), ms_psi_first_, m.psi ? m.psi_nr : 0, m.psi ? m.psi_nmus : 0);
-        glUniform3i(loc(p, "u_ms_irr"), ms_irr_first_, m.irradiance ? m.irr_nr : 0, m.irradiance ? m.irr_nmus : 0);
-    }
-    const glm::dvec3 eye = shading_eye(v);
-    const double r = glm::length(eye);
-    glUniform1f(loc(p, "u_eye_r"), float(r));
-    glUniform1f(loc(p, "u_eye_h"), float(r - atm.planet_radius_km));
-    const glm::vec3 up(eye / r);
-    glUniform3f(loc(p, "u_up"), up.x, up.y, up.z);
-    const glm::vec3 sun = glm::normalize(glm::vec3(v.sun));
-    glUniform3f(loc(p, "u_sun"), sun.x, sun.y, sun.z);
-    const glm::vec3 albedo(atm.ground_albedo), irr(atm.sun_irradiance);
-    glUniform3f(loc(p, "u_albedo"), albedo.x, albedo.y, albedo.z);
-    glUniform1i(loc(p, "u_published_ground"), options_.published_ground ? 1 : 0);
-    glUniform3f(loc(p, "u_irradiance"), irr.x, irr.y, irr.z);
-    glUniform1f(loc(p, "u_sun_cos_radius"), float(std::cos(atm.sun_angular_radius_rad)));
-    glUniform1f(loc(p, "u_sun_disc_radiance"),
-                options_.sun_disc
-                    ? float(1.0 / (3.14159265358979323846 * atm.sun_angular_radius_rad * atm.sun_angular_radius_rad))
-                    : 0.0f);
-    glUniform1i(loc(p, "u_steps"), model_.options().steps);
-    glUniform1i(loc(p, "u_spacing"), model_.options().uniform_steps ? 1 : 0);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_BUFFER, ms_tex_.get());
+    glActiveTexture(GL_TEXTURE0);
+    glUniform1i(loc(p, "u_ms"), 1);
     glUniformMatrix4fv(loc(p, "u_view_proj"), 1, GL_FALSE, glm::value_ptr(b.view_proj));
     glUniform3f(loc(p, "u_forward"), b.forward.x, b.forward.y, b.forward.z);
     glUniform3f(loc(p, "u_right"), b.right.x, b.right.y, b.right.z);

@@ -36,4 +36,5 @@ else()
 endif()
 skybake_embed_glsl(TARGET skybake_render DIR ${CMAKE_CURRENT_SOURCE_DIR}/render/shaders
   HEADER render/shaders.h NAMESPACE skybake::render::shaders
-  SHARED ${CMAKE_CURRENT_SOURCE_DIR}/core/tone_curve.h)
+  SHARED ${CMAKE_CURRENT_SOURCE_DIR}/core/tone_curve.h ${CMAKE_CURRENT_SOURCE_DIR}/sky/grid4_shared.h
+         ${CMAKE_CURRENT_SOURCE_DIR}/sky/sky_shared.h ${CMAKE_CURRENT_SOURCE_DIR}/sky/shade_shared.h)

@@ -6,6 +6,7 @@
 // program's vertex stage is screen_stages.glsl's FULL_SCREEN_VS, as is the
 // tone pass's, whose TONE_FS is there too.
 
+uniform RenderHD u_render;    // the scene and its atmosphere (sky/shade_shared.h)
 uniform mat4 u_view_proj;     // camera-relative world -> clip (rotation and projection only)
 uniform vec3 u_forward;       // camera basis (pinhole of sky::pixel_direction)
 uniform vec3 u_right;
@@ -14,10 +15,27 @@ uniform float u_tan_half_fov; // horizontal
 uniform vec2 u_viewport;      // pixels
 uniform int u_relief;         // 1: surface heights from the mesh
 
+// Everything but the sun disc along d; sun_t: the transmittance towards the
+// sun disc, 0 where the ray meets the ground.
+vec3 sb_shade_ray(vec3 d, out vec3 sun_t) {
+#ifdef SKYBAKE_SKY_REFERENCE
+    return shade_sky(u_render, d, true, sun_t);
+#else
+    return shade_sky_approximate(u_render, 0, d, true, sun_t);
+#endif
+}
+
+// The terrain seen along d at g (planet-centred, km): shade_surface.
+vec3 sb_shade_ground(vec3 d, vec3 g, vec3 nrm, float h_g, float dist) {
+#ifdef SKYBAKE_SKY_REFERENCE
+    return shade_surface(u_render, d, g, nrm, h_g, dist);
+#else
+    return shade_surface_approximate(u_render, 0, d, g, nrm, h_g);
+#endif
+}
+
 vec3 sb_add_sun(vec3 d, vec3 sun_t) {
-    if (u_sun_disc_radiance > 0.0 && dot(d, u_sun) >= u_sun_cos_radius)
-        return sun_t * u_sun_disc_radiance;
-    return vec3(0.0);
+    return sees_sun_disc(u_render, d) ? sun_t * u_render.sun_disc_radiance : vec3(0.0);
 }
 
 #if defined(SKYBAKE_STAGE_SKY_VS)
@@ -37,14 +55,14 @@ void main() {
     v_dir = d;
     vec3 ds = d;
     {
-        float cos_h = -sqrt(max(0.0, 1.0 - (u_R0 / u_eye_r) * (u_R0 / u_eye_r)));
-        float cz = dot(d, u_up);
+        float cos_h = -sqrt(max(0.0, 1.0 - (u_render.atm.R0 / u_render.eye_r) * (u_render.atm.R0 / u_render.eye_r)));
+        float cz = dot(d, u_render.zenith);
         if (cz < cos_h + 1e-4) {
-            vec3 hz = d - cz * u_up;
+            vec3 hz = d - cz * u_render.zenith;
             float lh = length(hz);
-            hz = lh > 1e-6 ? hz / lh : normalize(cross(u_up, vec3(0.3, 0.5, 0.8)));
+            hz = lh > 1e-6 ? hz / lh : normalize(cross(u_render.zenith, vec3(0.3, 0.5, 0.8)));
             float c = cos_h + 1e-4;
-            ds = c * u_up + sqrt(max(0.0, 1.0 - c * c)) * hz;
+            ds = c * u_render.zenith + sqrt(max(0.0, 1.0 - c * c)) * hz;
         }
     }
     vec3 sun_t;
@@ -62,7 +80,7 @@ void main() {
     vec3 d = normalize(u_forward + px * u_right + py * u_cam_up);
     vec3 sun_t;
     vec3 c = sb_shade_ray(d, sun_t);
-    o_colour = vec4((c + sb_add_sun(d, sun_t)) * u_irradiance, 1.0);
+    o_colour = vec4((c + sb_add_sun(d, sun_t)) * u_render.irradiance, 1.0);
 }
 #else
 in vec3 v_dir;
@@ -70,7 +88,7 @@ in vec3 v_colour;
 in vec3 v_sun_t;
 void main() {
     vec3 d = normalize(v_dir);
-    o_colour = vec4((v_colour + sb_add_sun(d, v_sun_t)) * u_irradiance, 1.0);
+    o_colour = vec4((v_colour + sb_add_sun(d, v_sun_t)) * u_render.irradiance, 1.0);
 }
 #endif
 
@@ -83,8 +101,8 @@ out vec3 v_colour;
 vec3 sb_ground(vec3 rel, vec3 nrm) {
     float dist = length(rel);
     vec3 d = rel / dist;
-    vec3 g = u_eye_r * u_up + rel;
-    float h_g = u_relief != 0 ? max(length(g) - u_R0, 0.0) : 0.0;
+    vec3 g = u_render.eye_r * u_render.zenith + rel;
+    float h_g = u_relief != 0 ? max(length(g) - u_render.atm.R0, 0.0) : 0.0;
     return sb_shade_ground(d, g, u_relief != 0 ? nrm : g / length(g), h_g, dist);
 }
 void main() {
@@ -105,8 +123,8 @@ out vec4 o_colour;
 vec3 sb_ground(vec3 rel, vec3 nrm) {
     float dist = length(rel);
     vec3 d = rel / dist;
-    vec3 g = u_eye_r * u_up + rel;
-    float h_g = u_relief != 0 ? max(length(g) - u_R0, 0.0) : 0.0;
+    vec3 g = u_render.eye_r * u_render.zenith + rel;
+    float h_g = u_relief != 0 ? max(length(g) - u_render.atm.R0, 0.0) : 0.0;
     return sb_shade_ground(d, g, u_relief != 0 ? normalize(nrm) : g / length(g), h_g, dist);
 }
 void main() {
@@ -116,9 +134,9 @@ void main() {
     // at the limb from seeing a chord's slightly different angles.
     vec3 sun_t;
     vec3 c = u_relief != 0 ? sb_ground(v_rel, v_normal) : sb_shade_ray(normalize(v_rel), sun_t);
-    o_colour = vec4(c * u_irradiance, 1.0);
+    o_colour = vec4(c * u_render.irradiance, 1.0);
 #else
-    o_colour = vec4(v_colour * u_irradiance, 1.0);
+    o_colour = vec4(v_colour * u_render.irradiance, 1.0);
 #endif
 }
 
@@ -133,6 +151,6 @@ void main() {
 #elif defined(SKYBAKE_STAGE_FLAT_FS)
 in vec3 v_normal;
 out vec4 o_colour;
-void main() { o_colour = vec4(vec3(max(dot(normalize(v_normal), u_sun), 0.0)), 1.0); }
+void main() { o_colour = vec4(vec3(max(dot(normalize(v_normal), u_render.sun), 0.0)), 1.0); }
 
 #endif

@@ -5,6 +5,7 @@
 #define SB_IN(T) in T
 #define SB_OUT(T) out T
 #define SB_INOUT(T) inout T
+#define SB_INIT(x)
 #define expf exp
 #define logf log
 #define sqrtf sqrt
@@ -14,3 +15,4 @@
 #define powf pow
 #define sinf sin
 #define cosf cos
+#define atan2f atan

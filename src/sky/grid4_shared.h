@@ -1,0 +1,79 @@
+// The coordinates of the multiple-scattering grids, written once in the
+// common subset of C++ and GLSL (core/shared_source.h) on a type `Real`:
+// C++ includes this file twice, with Real = float (the run-time look-ups of
+// sky_shared.h) and Real = double (the precomputation in scattering_orders.cpp),
+// and the planet renderer's shaders once with Real = float. The includer
+// defines Real and SB_REAL_SQRT (sqrtf for float, sqrt for double and GLSL).
+// No include guard, on purpose; what does not depend on Real is guarded.
+//
+// Bruneton E. A Qualitative and Quantitative Evaluation of 8 Clear Sky
+// Models. IEEE TVCG 2017, and its reference implementation "Precomputed
+// Atmospheric Scattering" (section "Texture coordinates"): the 4D grid over
+// (r, μ, μs, ν), with μ split at the horizon so that rays that meet the
+// ground and rays that do not are never interpolated together.
+//
+// Notation: r radius (km), μ cosine of the view direction to the local
+// vertical, μs cosine of the sun direction to the local vertical, ν cosine of
+// the view direction to the sun direction.
+
+#ifndef SKYBAKE_SKY_GRID4_SHARED_ONCE
+#define SKYBAKE_SKY_GRID4_SHARED_ONCE
+// Row-major index of a node: ((((ir·2 + lower)·nmu + imu)·nmus + imus)·nnu + inu);
+// lower = 1 for the half of the μ axis whose rays meet the ground.
+SKYBAKE_HD_INLINE int grid4_index(int nmu, int nmus, int nnu, int ir, int lower, int imu, int imus, int inu) {
+    return (((ir * 2 + lower) * nmu + imu) * nmus + imus) * nnu + inu;
+}
+#endif
+
+SKYBAKE_HD_INLINE Real hd_sqrt(Real x) { return SB_REAL_SQRT(x > Real(0) ? x : Real(0)); }
+
+SKYBAKE_HD_INLINE Real hd_clamp(Real x, Real lo, Real hi) { return x < lo ? lo : (x > hi ? hi : x); }
+
+// Distance from radius r along a ray with cosine mu to the top Rt (r ≤ Rt).
+SKYBAKE_HD_INLINE Real distance_to_top(Real r, Real mu, Real Rt) {
+    return -r * mu + hd_sqrt(r * r * (mu * mu - Real(1)) + Rt * Rt);
+}
+
+// The lower node and fraction of coordinate x on an axis of n nodes.
+SKYBAKE_HD_INLINE int grid_axis(Real x, int n, SB_OUT(Real) f) {
+    Real s = x * Real(n - 1);
+    s = s < Real(0) ? Real(0) : s;
+    int i = int(s);
+    i = i > n - 2 ? n - 2 : i;
+    f = s - Real(i);
+    f = f > Real(1) ? Real(1) : f;
+    return i;
+}
+
+// Bruneton 2017's mapping of a point to the unit-range coordinates of the 4D
+// grid (x = 0..1 on each axis), without the texel-centre offsets. ground = 1:
+// the ray meets the ground (the lower half of the μ axis).
+SKYBAKE_HD_INLINE void grid4_coordinates(Real R0, Real Rt, Real mu_s_min, Real r, Real mu, Real mu_s, Real nu,
+                                         SB_OUT(Real) xr, SB_OUT(Real) xmu, SB_OUT(Real) xmus, SB_OUT(Real) xnu,
+                                         SB_OUT(int) ground) {
+    Real H = hd_sqrt(Rt * Rt - R0 * R0);
+    r = hd_clamp(r, R0, Rt);
+    Real rho = hd_sqrt(r * r - R0 * R0);
+    xr = rho / H;
+    Real rmu = r * mu;
+    Real disc = rmu * rmu - r * r + R0 * R0;
+    ground = mu < Real(0) && disc >= Real(0) ? 1 : 0;
+    if (ground == 1) {
+        Real d = -rmu - hd_sqrt(disc);
+        Real dmin = r - R0;
+        Real dmax = rho;
+        xmu = dmax > dmin ? hd_clamp((d - dmin) / (dmax - dmin), Real(0), Real(1)) : Real(0);
+    } else {
+        Real d = -rmu + hd_sqrt(disc + H * H);
+        Real dmin = Rt - r;
+        Real dmax = rho + H;
+        xmu = hd_clamp((d - dmin) / (dmax - dmin), Real(0), Real(1));
+    }
+    Real dmin = Rt - R0;
+    Real dmax = H;
+    Real a = (distance_to_top(R0, mu_s, Rt) - dmin) / (dmax - dmin);
+    Real A = (distance_to_top(R0, mu_s_min, Rt) - dmin) / (dmax - dmin);
+    Real x = Real(1) - a / A;
+    xmus = hd_clamp((x > Real(0) ? x : Real(0)) / (Real(1) + a), Real(0), Real(1));
+    xnu = hd_clamp((nu + Real(1)) * Real(0.5), Real(0), Real(1));
+}
