@@ -207,6 +207,10 @@ public:
     // then gives it the largest chunks that set_rule() and memory allow,
     // instead of chunks sized for progress and interrupts.
     virtual bool prefers_large_chunks() const { return device_words_supported(); }
+    // How many acceleration structures set_mesh() builds (the raster
+    // backend's directional method: its maps' mesh and the CPU tracer's scene
+    // for the near field); a bake job's report counts them.
+    virtual int structures_per_mesh() const { return 1; }
 };
 
 // [SECTION] Backends -----------------------------------------------------------------------

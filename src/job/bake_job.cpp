@@ -30,13 +30,14 @@ public:
         mesh_ = &mesh;
         back_faces_ = back_faces;
         vertices_ = mesh.vertex_count();
-        ++builds_;
+        builds_ += tracer_->structures_per_mesh();
     }
     std::uint32_t set_rule(const TraceRule& rule) override { return tracer_->set_rule(rule); }
     void trace(const TraceChunk& chunk) override { tracer_->trace(chunk); }
     bool device_words_supported() const override { return tracer_->device_words_supported(); }
     const std::uint32_t* device_words() const override { return tracer_->device_words(); }
     bool prefers_large_chunks() const override { return tracer_->prefers_large_chunks(); }
+    int structures_per_mesh() const override { return tracer_->structures_per_mesh(); }
 
     bool answers_queries() const { return queries_ != nullptr; }
     // Whether the structure holds `mesh` with both sides occluding (as the preview casts).

@@ -4,6 +4,7 @@
 #include "visibility/raster/raster_tracer.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -112,6 +113,12 @@ struct RasterTracer::State {
     // Mesa, NVIDIA); else a geometry shader does. SKYBAKE_RASTER_GEOMETRY_SHADER=1
     // forces the geometry shader (tests of that path).
     bool vs_layer = false;
+
+    // Directional: the rays of the near field (answer_near_field), from the
+    // CPU tracer's own structure of the same mesh, and the last maps' texel.
+    std::unique_ptr<RayQueries> near;
+    float texel = 0.0f;
+    std::size_t edge_offset = 0;
 };
 
 RasterTracer::RasterTracer(TraceMethod method, std::uint32_t resolution)
@@ -228,6 +235,11 @@ void RasterTracer::set_mesh(const Mesh& mesh, BackFaces back_faces) {
     const Bounds bounds = compute_bounds(mesh);
     s_->centre = 0.5f * (bounds.min + bounds.max);
     s_->radius = std::max(0.5f * glm::length(bounds.extent()), 1e-30f);
+    if (method_ == TraceMethod::Directional) {
+        if (!s_->near)
+            s_->near = make_ray_queries(std::string(kNearFieldTracer));
+        s_->near->set_mesh(mesh, back_faces);
+    }
     s_->have_mesh = true;
     gl::check_gl("raster backend mesh upload");
 }
@@ -333,10 +345,13 @@ void RasterTracer::trace(const TraceChunk& chunk) {
         return;
     s_->context->make_current();
     const std::size_t words = std::size_t(chunk.count) * s_->rule.words_per_vertex;
-    if (words > s_->word_capacity) {
-        s_->word_buffer = storage_buffer(words * 4);
-        s_->word_capacity = words;
+    // Directional: the blocked words, then as many "edge" words (answer_near_field).
+    const std::size_t stored = method_ == TraceMethod::Directional ? 2 * words : words;
+    if (stored > s_->word_capacity) {
+        s_->word_buffer = storage_buffer(stored * 4);
+        s_->word_capacity = stored;
     }
+    s_->edge_offset = words;
     if (method_ == TraceMethod::Cube)
         trace_cube(chunk);
     else
@@ -345,11 +360,13 @@ void RasterTracer::trace(const TraceChunk& chunk) {
     // The blocked bits, in visiting order, become V in rule order: set where
     // the direction is on or above the horizon (the same test as every other
     // backend) and nothing was drawn closer than the maximum distance.
-    std::vector<std::uint32_t> blocked(words);
+    std::vector<std::uint32_t> blocked(stored);
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, s_->word_buffer.get());
-    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(words * 4), blocked.data());
+    glGetBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(stored * 4), blocked.data());
     gl::check_gl("raster backend read-back");
+    if (method_ == TraceMethod::Directional)
+        answer_near_field(chunk, blocked);
     const TraceRule& rule = s_->rule;
     const auto k = std::uint32_t(rule.points.size());
     parallel_for(chunk.count, 256, [&](std::size_t b, std::size_t e) {
@@ -367,6 +384,83 @@ void RasterTracer::trace(const TraceChunk& chunk) {
             }
         }
     });
+}
+
+// The directional maps answer a ray from a point kLookupTexels texels off its
+// origin (along the driver's offset direction), with the depth of the four
+// texels around it. Within kNearFieldTexels texels of the ray that answer is
+// not to be trusted, and rays of the CPU tracer (kNearFieldTracer, its own
+// structure of the same mesh) give it instead:
+//   - open: a blocker nearer the origin than the look-up point, along the ray,
+//     is behind the point (a thin part, a crevice): each direction the maps
+//     left open is traced up to kNearFieldTexels texels;
+//   - blocked by something near: a blocker within kNearFieldTexels texels of
+//     the look-up point may be beside the ray rather than on it (a ledge, a
+//     surface seen at a grazing angle, a texel's worth of blur): the direction
+//     is traced whole;
+//   - edges: where the four texels disagree, a blocker's edge passes within a
+//     texel or two of the ray: traced whole;
+//   - contacts: a surface that crosses the segment from the origin to the
+//     look-up point puts the point inside or behind it, where every map reads
+//     blocked: the vertex is traced whole.
+// The compute pass flags the second and third cases as "edge" bits.
+// blocked: the read-back words in visiting order, the blocked words and then
+// (from s_->edge_offset) the edge words.
+void RasterTracer::answer_near_field(const TraceChunk& chunk, std::vector<std::uint32_t>& blocked) {
+    const TraceRule& rule = s_->rule;
+    const auto k = std::uint32_t(rule.points.size());
+    const std::uint32_t wpv = rule.words_per_vertex;
+    const float lookup = kLookupTexels * s_->texel, reach = kNearFieldTexels * s_->texel;
+    const RayQueries& near = *s_->near;
+    std::atomic<std::uint64_t> contacts{0}, rays_traced{0};
+    parallel_for(chunk.count, 16, [&](std::size_t b, std::size_t e) {
+        std::vector<Ray> rays;
+        std::vector<std::uint8_t> hit;
+        std::vector<std::uint32_t> which;
+        for (std::size_t i = b; i < e; ++i) {
+            const glm::vec3 o = chunk.origins[i], n = chunk.normals[i];
+            const glm::vec3 t = chunk.offsets.empty() ? n : chunk.offsets[i];
+            Ray segment;
+            segment.origin = o;
+            segment.direction = t;
+            segment.t_max = lookup;
+            std::uint8_t contact = 0;
+            near.occluded({&segment, 1}, {&contact, 1});
+            contacts += contact;
+            std::uint32_t* mine = blocked.data() + i * wpv;
+            const std::uint32_t* edge = blocked.data() + s_->edge_offset + i * wpv;
+            rays.clear();
+            which.clear();
+            for (std::uint32_t j = 0; j < k; ++j) {
+                glm::vec3 x;
+                float c;
+                vertex_direction(rule.points[j], glm::mat3(1.0f), false, n, x, c);
+                if (!needs_ray(c))
+                    continue;
+                const bool whole = contact || get_bit(edge, j);
+                if (!whole && get_bit(mine, j))
+                    continue; // the maps saw a blocker beyond the near field
+                Ray r;
+                r.origin = o;
+                r.direction = x;
+                r.t_max = whole ? rule.t_max : reach;
+                rays.push_back(r);
+                which.push_back(j | (whole ? 0x80000000u : 0u));
+            }
+            hit.resize(rays.size());
+            near.occluded(rays, hit);
+            rays_traced += rays.size();
+            for (std::size_t q = 0; q < rays.size(); ++q) {
+                const std::uint32_t j = which[q] & 0x7fffffffu;
+                if (hit[q])
+                    set_bit(mine, j);
+                else if (which[q] & 0x80000000u)
+                    mine[j / 32] &= ~(1u << (j % 32));
+            }
+        }
+    });
+    near_contacts_ += contacts.load();
+    near_rays_ += rays_traced.load();
 }
 
 // The compute pass of both methods: the depth layers just drawn become the
@@ -390,7 +484,9 @@ void RasterTracer::run_bits(const BitsPass& pass) {
     glUniform1i(uniform(p, "u_resolution"), GLint(resolution_));
     glUniform1f(uniform(p, "u_far"), pass.far);
     glUniform1f(uniform(p, "u_t_max"), std::isfinite(rule.t_max) ? rule.t_max : 3.0e38f);
-    glUniform1f(uniform(p, "u_texel"), pass.texel);
+    glUniform1f(uniform(p, "u_lookup"), kLookupTexels * pass.texel);
+    glUniform1i(uniform(p, "u_edge_offset"), GLint(s.edge_offset));
+    glUniform1f(uniform(p, "u_recheck"), kNearFieldTexels * pass.texel);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.views.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.point_buffer.get());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s.vertex_buffer.get());
@@ -500,6 +596,7 @@ void RasterTracer::trace_directional(const TraceChunk& chunk) {
     r *= 1.01f;
     const glm::mat4 ortho = glm::ortho(-r, r, -r, r, 0.25f * r, 2.75f * r);
     const float range = 2.5f * r, texel = 2.0f * r / float(resolution_);
+    s.texel = texel;
     std::vector<glm::mat4> views(s.batch);
     std::vector<glm::vec4> eyes(s.batch);
     for (std::uint32_t j0 = 0; j0 < k; j0 += s.batch) {

@@ -8,9 +8,12 @@
 //                drawn per call, as layers of a depth texture array.
 //   Directional  for each rule direction, one orthographic depth map of the
 //                whole mesh seen along it; every vertex is tested against it
-//                with a slope-scaled bias. Cost: directions × (triangles +
-//                vertices) instead of vertices × directions. Needs a rule
-//                without +rotate and an unlimited maximum distance.
+//                from a point a few texels off its origin (the normal
+//                offset). Cost: directions × (triangles + vertices) instead
+//                of vertices × directions. Within kNearFieldTexels of the ray
+//                the maps' answer is checked by rays of the CPU tracer
+//                (answer_near_field). Needs a rule without +rotate and an
+//                unlimited maximum distance.
 // The depth maps become bits in a compute pass; only the bits are read back.
 // The GL headers stay in the .cpp (the tracer owns its own headless context).
 #pragma once
@@ -18,6 +21,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "skybake/visibility.h"
 
@@ -36,11 +40,17 @@ public:
     TraceMethod method() const override { return method_; }
     std::string device_name() const override;
     std::uint32_t resolution() const { return resolution_; }
+    // Directional: the vertices so far whose look-up segment met a surface
+    // (traced whole by the CPU tracer; see answer_near_field).
+    std::uint64_t near_contacts() const { return near_contacts_; }
+    // Directional: the rays traced so far by the CPU tracer (near field, edges, contacts).
+    std::uint64_t near_rays() const { return near_rays_; }
 
     void set_mesh(const Mesh& mesh, BackFaces back_faces = BackFaces::Occlude) override;
     std::uint32_t set_rule(const TraceRule& rule) override;
     void trace(const TraceChunk& chunk) override;
     bool prefers_large_chunks() const override { return true; }
+    int structures_per_mesh() const override { return method_ == TraceMethod::Directional ? 2 : 1; }
 
 private:
     struct State;
@@ -56,10 +66,20 @@ private:
     void run_bits(const BitsPass& pass);
     void trace_cube(const TraceChunk& chunk);
     void trace_directional(const TraceChunk& chunk);
+    void answer_near_field(const TraceChunk& chunk, std::vector<std::uint32_t>& blocked);
 
     TraceMethod method_;
     std::uint32_t resolution_;
     std::unique_ptr<State> s_;
+    std::uint64_t near_contacts_ = 0, near_rays_ = 0;
 };
+
+// The directional method's near field (docs/baking.md, answer_near_field): the
+// look-up point's offset from the ray origin and the distance within which the
+// maps' answer is checked by rays of the CPU tracer, in texels of the maps,
+// and that tracer.
+inline constexpr float kLookupTexels = 2.1214f;
+inline constexpr float kNearFieldTexels = 16.0f;
+inline constexpr const char* kNearFieldTracer = "embree";
 
 } // namespace skybake::visibility

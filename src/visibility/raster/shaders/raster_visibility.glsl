@@ -119,7 +119,9 @@ uniform int u_rotate;
 uniform int u_resolution;
 uniform float u_far;       // cube: depth scale; directional: the depth range
 uniform float u_t_max;     // cube: occluders further are ignored
-uniform float u_texel;     // directional: texel size, world units (the normal offset)
+uniform float u_lookup;    // directional: the normal offset, world units (kLookupTexels texels)
+uniform float u_recheck;   // directional: a blocker nearer than this beyond the look-up point (world units) is an edge
+uniform int u_edge_offset; // directional: where the "edge" words start in u_words (after the chunk's blocked words)
 
 ivec2 texel_of(vec2 ndc) {
     return clamp(ivec2(floor((ndc * 0.5 + 0.5) * float(u_resolution))), ivec2(0), ivec2(u_resolution - 1));
@@ -135,6 +137,7 @@ void main() {
     const int j0 = max(32 * w, u_first_point), j1 = min(32 * w + 32, u_last_point);
     const int slot = (u_first + v) * u_words_per_vertex + w;
     uint bits = 0u;
+    uint edge = 0u; // directional: the four texels disagree (a blocker's edge), left to the CPU tracer
     for (int j = j0; j < j1; ++j) {
         vec3 x = u_points[j].xyz;
 #if defined(SKYBAKE_CUBE)
@@ -159,7 +162,7 @@ void main() {
         // > 0 below it along x: the vertex's own surfaces never shadow it,
         // even at grazing directions, and only a small constant bias remains,
         // for depth rounding.
-        const vec3 q = vx.origin.xyz + (2.1214 * u_texel) * vx.t.xyz;
+        const vec3 q = vx.origin.xyz + u_lookup * vx.t.xyz;
         const vec4 clip = u_view[layer] * vec4(q, 1.0);
         const float mine = clip.z * 0.5 + 0.5 - 1e-6;
         // Percentage-closer filtering of the four texels around the point,
@@ -169,21 +172,26 @@ void main() {
         const ivec2 i0 = ivec2(floor(f));
         const vec2 w = f - vec2(i0);
         float blocked = 0.0;
+        float gap = 2.0; // the nearest blocker's distance beyond the look-up point, in depth units
         for (int dy = 0; dy < 2; ++dy)
             for (int dx = 0; dx < 2; ++dx) {
                 const ivec2 t = clamp(i0 + ivec2(dx, dy), ivec2(0), ivec2(u_resolution - 1));
                 const float depth = texelFetch(u_depth, ivec3(t, layer), 0).r;
                 const float weight = (dx == 1 ? w.x : 1.0 - w.x) * (dy == 1 ? w.y : 1.0 - w.y);
                 blocked += depth < mine ? weight : 0.0;
+                gap = depth < mine ? min(gap, mine - depth) : gap;
             }
         if (blocked > 0.5)
             bits |= 1u << uint(j & 31);
+        if ((blocked > 1e-4 && blocked < 0.9999) || (blocked > 0.5 && gap * u_far < u_recheck))
+            edge |= 1u << uint(j & 31);
 #endif
     }
 #if defined(SKYBAKE_CUBE)
     u_words[slot] = bits;
 #else
     u_words[slot] = (u_first_point > 32 * w ? u_words[slot] : 0u) | bits;
+    u_words[u_edge_offset + slot] = (u_first_point > 32 * w ? u_words[u_edge_offset + slot] : 0u) | edge;
 #endif
 }
 #endif
