@@ -1,4 +1,5 @@
-// skybake prt export [BAKED.glb] [--order L --channels C] [--model W.json --glossy A [--nodes N]] -o OUT.glsl
+// skybake prt export [BAKED.glb] [--order L --channels C] [--model W.json --glossy A [--nodes N]]
+//                   [--format glsl|glsl-es] -o OUT.glsl
 // The GLSL relighting functions (skybake/prt.h, [SECTION] Shader export).
 #include "cli.h"
 #include "commands.h"
@@ -12,7 +13,7 @@ void add_prt_export(CLI::App& group) {
     auto* sub =
         group.add_subcommand("export", "Write the GLSL relighting functions (diffuse PRT, DPRT with a network)");
     struct Opts {
-        std::string input, output, model, function = "skybake_prt", convention = "skybake";
+        std::string input, output, model, function = "skybake_prt", convention = "skybake", format = "glsl";
         int order = 3, channels = 1, nodes = 0;
         double glossy = 0.0;
     };
@@ -31,6 +32,8 @@ void add_prt_export(CLI::App& group) {
     sub->add_option("--nodes", o->nodes, "Nodes in cos θ of the Phong rule (default: order/2 + 1)")
         ->check(integer_in(1, 64));
     sub->add_option("--name", o->function, "Function name prefix (letters, digits and _)")->capture_default_str();
+    sub->add_option("--format", o->format, "glsl (3.30 and later) or glsl-es (GLSL ES 3.00, WebGL 2)")
+        ->capture_default_str();
     sub->add_option("--sh-convention", o->convention,
                     "Convention of the light[] the diffuse function takes: skybake (as `sky sh` writes by default) "
                     "or condon-shortley ((-1)^m, Sloan 2008 and D3DX: the function negates the odd-|m| terms)")
@@ -56,8 +59,11 @@ void add_prt_export(CLI::App& group) {
             order = m.transfer.order;
             channels = m.transfer.channels;
         }
+        if (o->format != "glsl" && o->format != "glsl-es")
+            throw UsageError(fmt::format("unknown format '{}'; use glsl or glsl-es", o->format), "--format");
         PrtShaderOptions so;
         so.function_name = o->function;
+        so.es = o->format == "glsl-es";
         so.light_convention = parse_flag("--sh-convention", [&] { return parse_sh_convention(o->convention); });
         NeuralSky net;
         SphereRule phong;

@@ -1,4 +1,4 @@
-// skybake sky export: a trained neural sky as a GLSL, HLSL, CUDA or C function.
+// skybake sky export: a trained neural sky as a GLSL, GLSL ES, HLSL, CUDA or C function.
 #include "cli.h"
 #include "commands.h"
 #include "flags.h"
@@ -15,7 +15,7 @@ void add_sky_export(CLI::App& group) {
     };
     auto o = std::make_shared<Opts>();
     sub->add_option("model", o->model, "Weights file (JSON from `skybake sky train`)")->required();
-    sub->add_option("--format", o->format, "glsl, hlsl, cuda or c")->required();
+    sub->add_option("--format", o->format, "glsl (3.30 and later), glsl-es (GLSL ES 3.00, WebGL 2), hlsl, cuda or c")->required();
     sub->add_option("-o,--output", o->output, "Output source file")->required();
     sub->add_option("--name", o->name, "Function name (letters, digits and _)")->capture_default_str();
     add_json_flag(*sub, o->json);

@@ -283,7 +283,8 @@ void save_learning_curve_png(const std::filesystem::path& path, const std::vecto
 //   C:    void NAME(..., float rgb[3])                       (C99, needs <math.h>)
 // It returns radiance per unit sun irradiance (1/sr); it works in vertex and
 // fragment shaders (no uniforms, no textures). All arithmetic is float.
-enum class ExportLanguage : int { Glsl = 0, Hlsl = 1, Cuda = 2, C = 3 };
+// GlslEs: GLSL ES 3.00 (WebGL 2), computing in highp whatever the shader's default precision.
+enum class ExportLanguage : int { Glsl = 0, Hlsl = 1, Cuda = 2, C = 3, GlslEs = 4 };
 ExportLanguage parse_export_language(std::string_view text, const std::string& where = "--format");
 std::string export_neural_sky(const NeuralSky& net, ExportLanguage language,
                               const std::string& function_name = "skybake_sky");

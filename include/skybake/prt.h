@@ -354,6 +354,9 @@ struct PrtShaderOptions {
     ShConvention light_convention = ShConvention::Skybake;
     const SphereRule* phong = nullptr; // a Phong rule: adds NAME_glossy (needs network)
     const NeuralSky* network = nullptr;
+    // GLSL ES 3.00 (WebGL 2) instead of GLSL 3.30: the functions compute in
+    // highp whatever the shader's default precision is.
+    bool es = false;
 };
 std::string export_prt_glsl(int order, int channels, const PrtShaderOptions& options = {});
 

@@ -134,7 +134,7 @@ void bind_sky(py::module_& m) {
                 return export_neural_sky(n, parse_export_language(language, "language"), function_name);
             },
             py::arg("language") = "glsl", py::arg("function_name") = "skybake_sky",
-            "Source of the network as a function: 'glsl', 'hlsl', 'cuda' or 'c'.")
+            "Source of the network as a function: 'glsl', 'glsl-es' (GLSL ES 3.00, WebGL 2), 'hlsl', 'cuda' or 'c'.")
         .def("__repr__", [](const NeuralSky& n) {
             return "NeuralSky(topology='" + n.topology.name() + "', weights=" + std::to_string(n.weights.size()) + ")";
         });

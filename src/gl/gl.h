@@ -40,18 +40,27 @@ public:
     int major_version() const { return major_; }
     int minor_version() const { return minor_; }
     bool has_clip_control() const { return clip_control_; }
+    // An OpenGL ES context (create_headless_context(GlApi::Es3)).
+    bool is_es() const { return es_; }
     // Whether the context is at least OpenGL major.minor.
     bool at_least(int major, int minor) const { return major_ * 10 + minor_ >= major * 10 + minor; }
 
 protected:
     // Reads and checks the version of the current context (throws below 3.3 core).
     void check_version(const std::string& where);
+    // The same for an OpenGL ES context: 3.0 or newer.
+    void check_es_version(const std::string& where);
     int major_ = 0, minor_ = 0;
     bool clip_control_ = false;
+    bool es_ = false;
 };
 
-// Headless EGL context (no window, no display server). Throws skybake::Error.
+// Headless EGL context (no window, no display server): desktop OpenGL 3.3
+// core or newer, or OpenGL ES 3.0 or newer (what WebGL 2 runs on: the tests of
+// exported GLSL ES). Throws skybake::Error.
+enum class GlApi { Desktop, Es3 };
 std::unique_ptr<GlContext> create_headless_context();
+std::unique_ptr<GlContext> create_headless_context(GlApi api);
 
 // [SECTION] RAII wrappers -------------------------------------------------------
 template <void (*Delete)(GLuint)>

@@ -55,7 +55,8 @@ bool has_extension(const char* list, const char* name) {
 
 class EglContext final : public GlContext {
 public:
-    EglContext() {
+    explicit EglContext(GlApi api) {
+        es_ = api == GlApi::Es3;
         const char* env = std::getenv("SKYBAKE_EGL_PLATFORM");
         const std::string platform = env && *env ? env : "auto";
         if (platform != "auto" && platform != "surfaceless" && platform != "device" && platform != "none")
@@ -85,25 +86,30 @@ public:
                             (tried.empty() ? std::string("no such EGL extension") : tried.substr(0, tried.size() - 2)) +
                             "); install libegl-mesa0 and libgl1-mesa-dri, or an NVIDIA driver with EGL",
                         kWhere);
-        if (!eglBindAPI(EGL_OPENGL_API))
-            fail("EGL cannot bind the desktop OpenGL API");
-        const EGLint config_attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_SURFACE_TYPE, EGL_PBUFFER_BIT,
-                                         EGL_NONE};
+        if (!eglBindAPI(es_ ? EGL_OPENGL_ES_API : EGL_OPENGL_API))
+            fail(es_ ? "EGL cannot bind the OpenGL ES API" : "EGL cannot bind the desktop OpenGL API");
+        const EGLint config_attribs[] = {EGL_RENDERABLE_TYPE, es_ ? EGL_OPENGL_ES3_BIT : EGL_OPENGL_BIT,
+                                         EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_NONE};
         EGLConfig config = nullptr;
         EGLint n = 0;
         if (!eglChooseConfig(display_, config_attribs, &config, 1, &n) || n < 1) {
             if (!has_extension(eglQueryString(display_, EGL_EXTENSIONS), "EGL_KHR_no_config_context"))
-                fail("EGL has no configuration for desktop OpenGL");
+                fail(es_ ? "EGL has no configuration for OpenGL ES 3" : "EGL has no configuration for desktop OpenGL");
             config = EGL_NO_CONFIG_KHR;
         }
-        const EGLint context_attribs[] = {
+        const EGLint desktop_attribs[] = {
             EGL_CONTEXT_MAJOR_VERSION,           3,       EGL_CONTEXT_MINOR_VERSION, 3, EGL_CONTEXT_OPENGL_PROFILE_MASK,
             EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
-        context_ = eglCreateContext(display_, config, EGL_NO_CONTEXT, context_attribs);
+        const EGLint es_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 0, EGL_NONE};
+        context_ = eglCreateContext(display_, config, EGL_NO_CONTEXT, es_ ? es_attribs : desktop_attribs);
         if (context_ == EGL_NO_CONTEXT)
-            fail("cannot create an OpenGL 3.3 core context with EGL");
+            fail(es_ ? "cannot create an OpenGL ES 3.0 context with EGL"
+                     : "cannot create an OpenGL 3.3 core context with EGL");
         make_current();
-        check_version(kWhere);
+        if (es_)
+            check_es_version(kWhere);
+        else
+            check_version(kWhere);
     }
     ~EglContext() override {
         if (display_ != EGL_NO_DISPLAY) {
@@ -164,8 +170,23 @@ void GlContext::check_version(const std::string& where) {
     clip_control_ = epoxy_gl_version() >= 45 || epoxy_has_gl_extension("GL_ARB_clip_control");
 }
 
-std::unique_ptr<GlContext> create_headless_context() {
-    return std::make_unique<EglContext>();
+void GlContext::check_es_version(const std::string& where) {
+    const char* v = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+    if (!v)
+        throw Error("the OpenGL ES context reports no version", where);
+    if (std::sscanf(v, "OpenGL ES %d.%d", &major_, &minor_) != 2)
+        throw Error(fmt::format("the context is '{}', not OpenGL ES", v), where);
+    if (major_ < 3)
+        throw Error(fmt::format("OpenGL ES {}.{} found; 3.0 or newer is needed (driver: {})", major_, minor_,
+                                description()),
+                    where);
+    es_ = true;
+}
+
+std::unique_ptr<GlContext> create_headless_context() { return create_headless_context(GlApi::Desktop); }
+
+std::unique_ptr<GlContext> create_headless_context(GlApi api) {
+    return std::make_unique<EglContext>(api);
 }
 
 } // namespace skybake::gl

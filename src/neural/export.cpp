@@ -20,13 +20,15 @@ using namespace neural;
 ExportLanguage parse_export_language(std::string_view text, const std::string& where) {
     if (text == "glsl")
         return ExportLanguage::Glsl;
+    if (text == "glsl-es")
+        return ExportLanguage::GlslEs;
     if (text == "hlsl")
         return ExportLanguage::Hlsl;
     if (text == "cuda")
         return ExportLanguage::Cuda;
     if (text == "c")
         return ExportLanguage::C;
-    throw Error(fmt::format("unknown export format '{}'; use glsl, hlsl, cuda or c", text), where);
+    throw Error(fmt::format("unknown export format '{}'; use glsl, glsl-es, hlsl, cuda or c", text), where);
 }
 
 namespace {
@@ -42,6 +44,7 @@ struct Dialect {
 Dialect dialect(ExportLanguage lang) {
     switch (lang) {
     case ExportLanguage::Glsl:
+    case ExportLanguage::GlslEs:
         return {true, "", "exp2", "exp", "vec3"};
     case ExportLanguage::Hlsl:
         return {true, "f", "exp2", "exp", "float3"};
@@ -210,7 +213,12 @@ void emit_phase_factored_decoding(std::ostringstream& o, const NeuralSky& net, c
 std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const ShaderExportOptions& options) {
     const std::string& name = options.function_name;
     net.validate("neural sky");
-    const bool ubo = options.uniform_block && lang == ExportLanguage::Glsl;
+    const bool es = lang == ExportLanguage::GlslEs;
+    // GLSL ES: the function computes in highp whatever the shader's default
+    // precision is (its parameters, return value and block are qualified; a
+    // precision statement inside the body covers its locals).
+    const std::string hp = es ? "highp " : "";
+    const bool ubo = options.uniform_block && (lang == ExportLanguage::Glsl || es);
     if (ubo && !valid_shader_identifier(options.block_name))
         throw Error(fmt::format("'{}' is not a valid uniform block name", options.block_name), "block_name");
     if (!valid_shader_identifier(name))
@@ -228,7 +236,7 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const S
     const MlpHD m = make_mlp_hd(net);
     const std::size_t n_block = (n_weights + encoding_constants(net).size() + 3) / 4;
     std::ostringstream o;
-    const char* lang_name[] = {"GLSL", "HLSL", "CUDA", "C"};
+    const char* lang_name[] = {"GLSL", "HLSL", "CUDA", "C", "GLSL ES (WebGL)"};
     if (ubo) // the text must not depend on the weights or what they were trained on
         o << fmt::format("// {}: neural sky (skybake), {} network, {} weights in a uniform block.\n", name,
                          net.topology.name(), net.topology.weight_count());
@@ -269,19 +277,22 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const S
     default:
         o << "\n";
         if (ubo)
-            o << fmt::format("layout(std140) uniform {} {{\n    vec4 {}[{}];\n}};\n\n", options.block_name, wname,
-                             n_block);
+            o << fmt::format("layout(std140) uniform {} {{\n    {}vec4 {}[{}];\n}};\n\n", options.block_name, hp,
+                             wname, n_block);
         break;
     }
     // Activation f(x) = 1/(1 + 2^(2x)).
-    o << fmt::format("{}float {}(float x) {{ return {} / ({} + {}({} * x)); }}\n\n", qual, f, lit(1.0f, d),
-                     lit(1.0f, d), d.exp2, lit(2.0f, d));
-    const std::string params =
-        "float cos_view_zenith, float cos_view_sun, float cos_sun_zenith, float density";
+    o << fmt::format("{}{}float {}({}float x) {{ return {} / ({} + {}({} * x)); }}\n\n", qual, hp, f, hp,
+                     lit(1.0f, d), lit(1.0f, d), d.exp2, lit(2.0f, d));
+    const std::string params = fmt::format("{0}float cos_view_zenith, {0}float cos_view_sun, {0}float cos_sun_zenith, "
+                                           "{0}float density",
+                                           hp);
     if (d.shader)
-        o << fmt::format("{} {}({}) {{\n", d.vec3, name, params);
+        o << fmt::format("{}{} {}({}) {{\n", hp, d.vec3, name, params);
     else
         o << fmt::format("{}void {}({}, float rgb[3]) {{\n", lang == ExportLanguage::C ? "" : qual, name, params);
+    if (es)
+        o << "    precision highp float;\n";
     const char* cst = d.shader ? "" : "const ";
     // Constants of the encoding: literals, or values of the uniform block after the weights.
     std::size_t next_uniform = n_weights;

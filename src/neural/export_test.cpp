@@ -175,7 +175,16 @@ TEST(NeuralExport, GlslCompilesInVertexAndFragmentShaders) {
         write(dir / "sky.frag", "#version 300 es\nprecision highp float;\n" + fn +
                                     "in vec4 dirs;\nout vec4 frag;\n"
                                     "void main() { frag = vec4(skybake_sky(dirs.x, dirs.y, dirs.z, dirs.w), 1.0); }\n");
-        for (const char* stage : {"sky.vert", "sky.frag"}) {
+        // GLSL ES 3.00 (WebGL 2) under a mediump default, in both stages.
+        const std::string es = export_neural_sky(net, ExportLanguage::GlslEs);
+        write(dir / "sky_es.frag", "#version 300 es\nprecision mediump float;\n" + es +
+                                       "in vec4 dirs;\nout vec4 frag;\n"
+                                       "void main() { frag = vec4(skybake_sky(dirs.x, dirs.y, dirs.z, dirs.w), 1.0); }\n");
+        write(dir / "sky_es.vert", "#version 300 es\n" + es +
+                                       "in vec4 attr;\nout vec3 colour;\n"
+                                       "void main() {\n    colour = skybake_sky(attr.x, attr.y, attr.z, attr.w);\n"
+                                       "    gl_Position = vec4(attr.xyz, 1.0);\n}\n");
+        for (const char* stage : {"sky.vert", "sky.frag", "sky_es.vert", "sky_es.frag"}) {
             const std::string cmd = fmt::format("glslangValidator {} > {} 2>&1", (dir / stage).string(),
                                                 (dir / "log.txt").string());
             const int rc = std::system(cmd.c_str());
@@ -249,7 +258,8 @@ TEST(NeuralExport, ShaderLiteralsEqualTheCExports) {
             std::sort(sorted_w.begin(), sorted_w.end());
             EXPECT_TRUE(std::includes(sorted_c.begin(), sorted_c.end(), sorted_w.begin(), sorted_w.end())) << top;
             const auto [c_net, c_decode] = split_at_decoding(export_neural_sky(net, ExportLanguage::C));
-            for (ExportLanguage lang : {ExportLanguage::Glsl, ExportLanguage::Hlsl, ExportLanguage::Cuda}) {
+            for (ExportLanguage lang :
+                 {ExportLanguage::Glsl, ExportLanguage::GlslEs, ExportLanguage::Hlsl, ExportLanguage::Cuda}) {
                 const auto [o_net, o_decode] = split_at_decoding(export_neural_sky(net, lang));
                 // The layers: the same literals in the same order.
                 ASSERT_EQ(o_net.size(), c_net.size()) << top << " language " << int(lang);

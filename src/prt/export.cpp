@@ -37,9 +37,14 @@ std::string export_prt_glsl(int order, int channels, const PrtShaderOptions& o) 
     const int nc = sh_count(order);
     const int attrs = (channels * nc + 3) / 4;
     const char* lane = "xyzw";
-    std::string s = fmt::format("// skybake PRT relighting: SH order {} ({} coefficients), {} transfer.\n", order, nc,
-                                channels == 1 ? "grey" : "RGB");
-    s += fmt::format("vec3 {}_diffuse(vec4 prt[{}], vec3 light[{}], vec3 albedo) {{\n", name, attrs, nc);
+    // GLSL ES: highp parameters and results, and a precision statement for the body's locals.
+    const std::string hp = o.es ? "highp " : "";
+    const std::string body_precision = o.es ? "    precision highp float;\n" : "";
+    std::string s = fmt::format("// skybake PRT relighting: SH order {} ({} coefficients), {} transfer; {}.\n", order,
+                                nc, channels == 1 ? "grey" : "RGB", o.es ? "GLSL ES (WebGL)" : "GLSL");
+    s += fmt::format("{0}vec3 {1}_diffuse({0}vec4 prt[{2}], {0}vec3 light[{3}], {0}vec3 albedo) {{\n", hp, name, attrs,
+                     nc);
+    s += body_precision;
     // The sign of each term: light[] in o.light_convention, the transfer in skybake's.
     std::vector<char> sign(std::size_t(nc), '+');
     for (int l = 0; l <= order; ++l)
@@ -66,10 +71,11 @@ std::string export_prt_glsl(int order, int channels, const PrtShaderOptions& o) 
     if (o.phong) {
         ShaderExportOptions e;
         e.function_name = name + "_sky";
-        s += export_neural_sky(*o.network, ExportLanguage::Glsl, e);
+        s += export_neural_sky(*o.network, o.es ? ExportLanguage::GlslEs : ExportLanguage::Glsl, e);
         s += fmt::format("// DPRT: Σ_k λ_k sky(g x_k) over {} ({} points), g taking +z to the mirror direction.\n",
                          o.phong->spec, o.phong->size());
-        s += fmt::format("vec3 {}_glossy(vec3 n, vec3 v, vec3 sun, float density) {{\n", name);
+        s += fmt::format("{0}vec3 {1}_glossy({0}vec3 n, {0}vec3 v, {0}vec3 sun, {0}float density) {{\n", hp, name);
+        s += body_precision;
         s += "    vec3 r = normalize(2.0 * dot(n, v) * n - v);\n"
              "    float sg = r.z >= 0.0 ? 1.0 : -1.0;\n"
              "    float a = -1.0 / (sg + r.z);\n"

@@ -68,7 +68,19 @@ TEST(PrtExport, GlslCompiles) {
                                  "void main() { frag = vec4(skybake_prt_diffuse(t, light, vec3(0.5)) + "
                                  "skybake_prt_glossy(normalize(nrm), vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), "
                                  "0.5), 1.0); }\n";
-        for (const auto& [name, text] : {std::pair{"prt.vert", vert}, std::pair{"prt.frag", frag}}) {
+        // GLSL ES 3.00 (WebGL 2) under a mediump default.
+        o.es = true;
+        const std::string es = export_prt_glsl(3, channels, o);
+        o.es = false;
+        EXPECT_NE(es.find("highp vec3 skybake_prt_diffuse("), std::string::npos);
+        const std::string frag_es = "#version 300 es\nprecision mediump float;\n" + es +
+                                    "uniform vec3 light[16];\nuniform vec4 t[" + std::to_string(m) +
+                                    "];\nin vec3 nrm;\nout vec4 frag;\n"
+                                    "void main() { frag = vec4(skybake_prt_diffuse(t, light, vec3(0.5)) + "
+                                    "skybake_prt_glossy(normalize(nrm), vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), "
+                                    "0.5), 1.0); }\n";
+        for (const auto& [name, text] :
+             {std::pair{"prt.vert", vert}, std::pair{"prt.frag", frag}, std::pair{"prt_es.frag", frag_es}}) {
             std::ofstream(dir / name) << text;
             const std::string cmd =
                 fmt::format("glslangValidator {} > {} 2>&1", (dir / name).string(), (dir / "log.txt").string());

@@ -51,9 +51,26 @@ constexpr const char* kFsMain = "uniform sampler2D u_in;\n"
                                 "    o = vec4(skybake_sky(x.x, x.y, x.z, x.w), 1.0);\n"
                                 "}\n";
 
-// Worst relative RGB error |ΔI|/|I| of the GLSL network over 100x100 inputs.
-double glsl_network_error(const NeuralSky& net, int* compared) {
-    auto ctx = create_headless_context();
+// GLSL ES 3.00 (WebGL 2): the same, in an OpenGL ES 3.0 context, with a
+// fragment shader whose default float precision is mediump (the exported
+// function computes in highp regardless).
+constexpr const char* kVsEs = "#version 300 es\n"
+                              "void main() {\n"
+                              "    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));\n"
+                              "    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n"
+                              "}\n";
+constexpr const char* kFsEsHead = "#version 300 es\nprecision mediump float;\n";
+constexpr const char* kFsEsMain = "uniform highp sampler2D u_in;\n"
+                                  "out highp vec4 o;\n"
+                                  "void main() {\n"
+                                  "    highp vec4 x = texelFetch(u_in, ivec2(gl_FragCoord.xy), 0);\n"
+                                  "    o = vec4(skybake_sky(x.x, x.y, x.z, x.w), 1.0);\n"
+                                  "}\n";
+
+// Worst relative RGB error |ΔI|/|I| of the GLSL (or GLSL ES) network over 100x100 inputs.
+double glsl_network_error(const NeuralSky& net, int* compared, ExportLanguage lang = ExportLanguage::Glsl) {
+    const bool es = lang == ExportLanguage::GlslEs;
+    auto ctx = create_headless_context(es ? GlApi::Es3 : GlApi::Desktop);
     const int W = 100, H = 100;
     std::mt19937_64 rng(11);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f), d(0.0f, 1.0f);
@@ -71,8 +88,9 @@ double glsl_network_error(const NeuralSky& net, int* compared) {
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     ShaderExportOptions eo;
     eo.uniform_block = true;
-    const std::string fn = export_neural_sky(net, ExportLanguage::Glsl, eo);
-    Program p = link_program("network test", ShaderSource{{kVs}}, ShaderSource{{"#version 330 core\n", fn, kFsMain}});
+    const std::string fn = export_neural_sky(net, lang, eo);
+    Program p = es ? link_program("network test (GLSL ES)", ShaderSource{{kVsEs}}, ShaderSource{{kFsEsHead, fn, kFsEsMain}})
+                   : link_program("network test", ShaderSource{{kVs}}, ShaderSource{{"#version 330 core\n", fn, kFsMain}});
     const std::vector<float> data = neural_sky_uniform_data(net);
     Buffer ubo = make_buffer();
     glBindBuffer(GL_UNIFORM_BUFFER, ubo.get());
@@ -128,6 +146,31 @@ TEST(GlNetwork, WiderSharedTopologyMatchesToo) {
     EXPECT_GT(compared, 5000);
     EXPECT_LT(err, 1e-5);
     std::printf("GLSL network (shared:16x16) vs mlp_hd.h: max relative error %.3g over %d inputs\n", err, compared);
+}
+
+// `sky export --format glsl-es` (WebGL 2) in an OpenGL ES 3.0 context, every
+// encoding: the same arithmetic as the library.
+TEST(GlNetwork, GlslEsMatchesTheCppForwardPassInAnEsContext) {
+    for (InputEncoding inputs : {InputEncoding::Seed, InputEncoding::Horizon})
+        for (OutputEncoding outputs : {OutputEncoding::Radiance, OutputEncoding::PhaseFactored}) {
+            NeuralSky net = neural_test::with_encoding(neural_test::random_network("shared:12x8", 7), inputs,
+                                                       outputs, 8);
+            for (float& w : net.weights)
+                w *= 0.5f;
+            int compared = 0;
+            const double err = glsl_network_error(net, &compared, ExportLanguage::GlslEs);
+            SCOPED_TRACE(std::string(input_encoding_name(inputs)) + " / " + output_encoding_name(outputs));
+            EXPECT_GT(compared, 3000);
+            EXPECT_LT(err, 1e-5);
+            std::printf("GLSL ES network (%s inputs, %s outputs) vs mlp_hd.h: max relative error %.3g over %d inputs\n",
+                        input_encoding_name(inputs), output_encoding_name(outputs), err, compared);
+        }
+    int compared = 0;
+    const double err = glsl_network_error(random_net("paper", 5), &compared, ExportLanguage::GlslEs);
+    EXPECT_LT(err, 1e-5);
+    auto ctx = create_headless_context(GlApi::Es3);
+    EXPECT_TRUE(ctx->is_es());
+    EXPECT_GE(ctx->major_version(), 3);
 }
 
 // Horizon inputs and phase-factored outputs: the encoding constants after the
