@@ -216,9 +216,21 @@ TEST(NeuralCli, ErrorReport) {
     EXPECT_GT(j["min_view_psnr_db"].get<double>(), 0.0);
     EXPECT_TRUE(fs::exists(dir + "/views/1_sea_level_neural.png"));
     EXPECT_TRUE(fs::exists(dir + "/views/1_sea_level_reference.png"));
-    auto t = run_cli({"sky", "error", "--model", tiny_model(), "--samples", "500", "--no-views"});
+    // The flight's samples (altitude 0-60 km, the sun down to -20 degrees), counted apart.
+    const auto& f = j["flight"];
+    EXPECT_EQ(f["samples"].get<int>(), 100000);
+    EXPECT_EQ(f["relative_error"]["all"]["count"].get<int>() + f["night_absolute_error_over_max_n"]["count"].get<int>(),
+              100000);
+    EXPECT_EQ(f["max_altitude_km"].get<double>(), 60.0);
+    auto t = run_cli({"sky", "error", "--model", tiny_model(), "--samples", "500", "--no-views", "--flight-samples",
+                      "300"});
     ASSERT_EQ(t.exit_code, 0) << t.err;
     EXPECT_NE(t.out.find("day (sun above horizon)"), std::string::npos);
+    EXPECT_NE(t.out.find("flight: 300 samples, altitude 0 to 60 km, sun down to -20 deg"), std::string::npos);
+    auto none = run_cli({"sky", "error", "--model", tiny_model(), "--samples", "500", "--no-views", "--flight-samples",
+                         "0", "--json"});
+    ASSERT_EQ(none.exit_code, 0) << none.err;
+    EXPECT_FALSE(nlohmann::json::parse(none.out).contains("flight"));
 }
 
 TEST(NeuralCli, TheSeedsNetworkIsOneFlagSet) {

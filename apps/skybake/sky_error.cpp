@@ -32,6 +32,11 @@ void add_sky_error(CLI::App& group) {
         ->capture_default_str();
     sub->add_option("--seed", o->e.seed, "Seed of the held-out samples (default: a stream not used in training)")
         ->check(integer_in(0, INT64_MAX));
+    sub->add_option("--flight-samples", o->e.flight_samples,
+                    "Samples of a flight to space: altitude uniform in 0-60 km, the sun down to -20 degrees, any view "
+                    "(0: none)")
+        ->check(integer_in(0, 100'000'000))
+        ->capture_default_str();
     sub->add_flag("--no-views", o->no_views, "Skip the PSNR of the seed's views");
     sub->add_option("--size", o->size, "Size of the rendered views WxH")->capture_default_str();
     sub->add_option("--views-dir", o->views_dir, "Also write the reference and neural views there as PNG (a "
@@ -65,6 +70,14 @@ void add_sky_error(CLI::App& group) {
                                                     {"twilight", stats_json(r.twilight)}}},
                                 {"night_absolute_error_over_max_n", stats_json(r.night)},
                                 {"views", views}};
+            if (o->e.flight_samples > 0)
+                j["flight"] = {{"samples", o->e.flight_samples},
+                               {"max_altitude_km", o->e.flight.max_altitude_km},
+                               {"min_sun_elevation_deg", o->e.flight.min_sun_elevation_deg},
+                               {"relative_error", {{"all", stats_json(r.flight_all)},
+                                                   {"day", stats_json(r.flight_day)},
+                                                   {"twilight", stats_json(r.flight_twilight)}}},
+                               {"night_absolute_error_over_max_n", stats_json(r.flight_night)}};
             if (!r.views.empty()) {
                 j["mean_view_psnr_db"] = r.mean_view_psnr_db;
                 j["min_view_psnr_db"] = r.min_view_psnr_db;
@@ -84,6 +97,13 @@ void add_sky_error(CLI::App& group) {
         row("twilight (sun below, N > 0)", r.twilight);
         t += fmt::format("night (N = 0): {} samples, |dI|/max N mean {:.2e}, max {:.2e}\n", r.night.count,
                          r.night.mean, r.night.max);
+        if (o->e.flight_samples > 0) {
+            t += fmt::format("flight: {} samples, altitude 0 to {:g} km, sun down to {:g} deg\n", o->e.flight_samples,
+                             o->e.flight.max_altitude_km, o->e.flight.min_sun_elevation_deg);
+            row("flight, all (N > 0)", r.flight_all);
+            row("flight, day", r.flight_day);
+            row("flight, twilight", r.flight_twilight);
+        }
         for (const ViewPsnr& v : r.views)
             t += fmt::format("view {:<14} PSNR {:6.2f} dB\n", v.name, v.psnr_db);
         if (!r.views.empty())

@@ -330,6 +330,10 @@ struct ViewPsnr {
 struct NeuralErrorReport {
     ErrorStats all, day, twilight; // relative errors
     ErrorStats night;              // |ΔI| / max{N}
+    // The same over the samples of a flight (draw_flight_samples: altitude
+    // uniform from 0 to 60 km, the sun down to −20°), where a flight from the
+    // ground to space spends its time; empty with flight_samples = 0.
+    ErrorStats flight_all, flight_day, flight_twilight, flight_night;
     std::vector<ViewPsnr> views;
     double mean_view_psnr_db = 0.0;
     double min_view_psnr_db = 0.0;
@@ -338,6 +342,8 @@ struct NeuralErrorReport {
 struct NeuralErrorOptions {
     std::size_t samples = 100000;
     std::uint64_t seed = 0x5eed000e77;  // distinct from the training streams
+    std::size_t flight_samples = 100000; // draw_flight_samples, from the same seed; 0: none
+    FlightSampling flight;
     bool views = true;                  // render the seed's views and compare
     int view_width = 240, view_height = 160;
     std::filesystem::path views_dir;    // when not empty: write NAME_reference.png and NAME_neural.png there

@@ -203,6 +203,17 @@ std::vector<SkySample> read_sky_samples_csv(std::string_view text, const std::st
 // `count` valid samples drawn uniformly from [−1,1]³ × (0,1] with rejection of
 // invalid triples; deterministic in seed, independent of the thread count.
 std::vector<SkySample> draw_sky_samples(std::size_t count, std::uint64_t seed);
+// The samples of a flight from the ground to space: the observer's altitude
+// uniform in [0, max_altitude_km] (density = Atmosphere::density_from_altitude),
+// the sun's elevation uniform in [min_sun_elevation_deg, 90°], the view
+// direction uniform on the sphere. Deterministic in seed. Throws
+// skybake::Error ("FlightSampling") for a range that is empty.
+struct FlightSampling {
+    double max_altitude_km = 60.0;
+    double min_sun_elevation_deg = -20.0;
+};
+std::vector<SkySample> draw_flight_samples(std::size_t count, std::uint64_t seed, const Atmosphere& atmosphere,
+                                           const FlightSampling& sampling = {});
 
 // [SECTION] Optical-length tables -------------------------------------------------
 //

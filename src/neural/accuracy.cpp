@@ -42,28 +42,36 @@ NeuralErrorReport neural::measure_approximation_error(const SkyModel& model, dou
         throw Error("the number of samples must be 1 to 2^28", "samples");
     if (o.views && (o.view_width < 1 || o.view_height < 1 || o.view_width > 4096 || o.view_height > 4096))
         throw Error("view size must be 1 to 4096 pixels on each side", "view_width/view_height");
-    const std::vector<SkySample> samples = draw_sky_samples(o.samples, o.seed);
-    std::vector<glm::vec3> ref(samples.size()), got(samples.size());
-    evaluate_sky(model, samples, ref, SkyMethod::Tables);
-    evaluate(samples, got);
-
-    std::vector<double> all, day, twilight, night;
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-        const glm::dvec3 r(ref[i]), g(got[i]);
-        const double err = glm::length(g - r);
-        if (!(std::max({r.x, r.y, r.z}) > 0.0)) {
-            night.push_back(err / max_n);
-            continue;
-        }
-        const double rel = err / glm::length(r);
-        all.push_back(rel);
-        (samples[i].cos_sun_zenith > 0.0f ? day : twilight).push_back(rel);
-    }
+    if (o.flight_samples > (std::size_t(1) << 28))
+        throw Error("the number of flight samples must be 0 to 2^28", "flight_samples");
     NeuralErrorReport rep;
-    rep.all = error_stats(all);
-    rep.day = error_stats(day);
-    rep.twilight = error_stats(twilight);
-    rep.night = error_stats(night);
+    // Relative errors of `samples`, split into all lit, day and twilight, and night.
+    const auto measure = [&](const std::vector<SkySample>& samples, ErrorStats& all_s, ErrorStats& day_s,
+                             ErrorStats& twilight_s, ErrorStats& night_s) {
+        std::vector<glm::vec3> ref(samples.size()), got(samples.size());
+        evaluate_sky(model, samples, ref, SkyMethod::Tables);
+        evaluate(samples, got);
+        std::vector<double> all, day, twilight, night;
+        for (std::size_t i = 0; i < samples.size(); ++i) {
+            const glm::dvec3 r(ref[i]), g(got[i]);
+            const double err = glm::length(g - r);
+            if (!(std::max({r.x, r.y, r.z}) > 0.0)) {
+                night.push_back(err / max_n);
+                continue;
+            }
+            const double rel = err / glm::length(r);
+            all.push_back(rel);
+            (samples[i].cos_sun_zenith > 0.0f ? day : twilight).push_back(rel);
+        }
+        all_s = error_stats(all);
+        day_s = error_stats(day);
+        twilight_s = error_stats(twilight);
+        night_s = error_stats(night);
+    };
+    measure(draw_sky_samples(o.samples, o.seed), rep.all, rep.day, rep.twilight, rep.night);
+    if (o.flight_samples > 0)
+        measure(draw_flight_samples(o.flight_samples, o.seed, model.atmosphere(), o.flight), rep.flight_all,
+                rep.flight_day, rep.flight_twilight, rep.flight_night);
 
     if (o.views) {
         if (!o.views_dir.empty())

@@ -6,6 +6,7 @@
 //     | c b 1 |
 // is positive semi-definite, i.e. its determinant 1 + 2abc − a² − b² − c² ≥ 0
 // (the 2×2 minors 1 − a² etc. are then non-negative too).
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -71,6 +72,37 @@ std::vector<SkySample> draw_sky_samples(std::size_t count, std::uint64_t seed) {
                 SkySample s{float(a), float(b), float(c), float(rho)};
                 if (s.density > 0.0f && cosine_triple_determinant(s.cos_view_zenith, s.cos_view_sun,
                                                                   s.cos_sun_zenith) >= 0.0) {
+                    out[i] = s;
+                    break;
+                }
+            }
+        }
+    });
+    return out;
+}
+
+std::vector<SkySample> draw_flight_samples(std::size_t count, std::uint64_t seed, const Atmosphere& atmosphere,
+                                           const FlightSampling& f) {
+    if (!(f.max_altitude_km > 0.0) || !(f.min_sun_elevation_deg >= -90.0 && f.min_sun_elevation_deg < 90.0))
+        throw Error("the flight samples need a maximum altitude > 0 and a lowest sun elevation in [-90, 90) degrees",
+                    "FlightSampling");
+    const double pi = 3.14159265358979323846, lo = f.min_sun_elevation_deg * pi / 180.0;
+    std::vector<SkySample> out(count);
+    parallel_for(count, 4096, [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end; ++i) {
+            SplitMix rng{seed * 0xD1B54A32D192ED03ull + i * 0x9E3779B97F4A7C15ull + 0x5f1147ull};
+            rng.next();
+            for (;;) {
+                const double h = f.max_altitude_km * rng.uniform();
+                const double elevation = lo + (0.5 * pi - lo) * rng.uniform();
+                const double cz = 2.0 * rng.uniform() - 1.0; // the view direction, uniform on the sphere
+                const double phi = 2.0 * pi * rng.uniform(); // its azimuth from the sun's
+                const double cs = std::sin(elevation);
+                const double cvs = cz * cs + std::sqrt(std::max(0.0, (1.0 - cz * cz) * (1.0 - cs * cs))) * std::cos(phi);
+                SkySample s{float(cz), float(std::clamp(cvs, -1.0, 1.0)), float(cs),
+                            float(atmosphere.density_from_altitude(h))};
+                if (s.density > 0.0f &&
+                    cosine_triple_determinant(s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith) >= 0.0) {
                     out[i] = s;
                     break;
                 }

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "skybake/core.h"
+#include "skybake/error.h"
 #include "skybake/sky.h"
 #include "sky/rounding_model_test_util.h"
 #include "sky/sky_hd.h"
@@ -160,6 +161,42 @@ TEST(SampleSpace, DrawnSamplesAreValidAndDeterministic) {
         EXPECT_EQ(a[i].cos_view_sun, b[i].cos_view_sun);
         EXPECT_EQ(a[i].density, b[i].density);
     }
+}
+
+// The flight samples: valid triples; altitudes (read back from the density)
+// uniform in [0, 60] km and sun elevations uniform in [-20, 90] degrees, by
+// their means and ranges; view directions uniform on the sphere (mean cos 0);
+// the same samples on one thread.
+TEST(SampleSpace, FlightSamplesCoverTheFlightUniformly) {
+    const Atmosphere atm = atmosphere_preset("earth");
+    const std::size_t n = 20000;
+    const auto a = draw_flight_samples(n, 7, atm);
+    set_thread_count(1);
+    const auto b = draw_flight_samples(n, 7, atm);
+    set_thread_count(0);
+    double h_sum = 0.0, h_max = 0.0, e_sum = 0.0, e_min = 90.0, cz_sum = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+        ASSERT_TRUE(is_valid_sky_sample(a[i], 1e-6)) << i;
+        ASSERT_EQ(a[i].cos_view_sun, b[i].cos_view_sun);
+        const double h = atm.altitude_from_density(a[i].density);
+        const double e = std::asin(double(a[i].cos_sun_zenith)) * 180.0 / 3.14159265358979323846;
+        h_sum += h;
+        h_max = std::max(h_max, h);
+        e_sum += e;
+        e_min = std::min(e_min, e);
+        cz_sum += a[i].cos_view_zenith;
+    }
+    // Standard errors: 60/sqrt(12 n) = 0.12 km, 110/sqrt(12 n) = 0.22 degrees, 1/sqrt(3 n) = 0.004.
+    EXPECT_NEAR(h_sum / double(n), 30.0, 0.6);
+    EXPECT_LE(h_max, 60.0 + 1e-3);
+    EXPECT_GT(h_max, 59.0);
+    EXPECT_NEAR(e_sum / double(n), 35.0, 1.1);
+    EXPECT_GE(e_min, -20.0 - 1e-3);
+    EXPECT_LT(e_min, -19.0);
+    EXPECT_NEAR(cz_sum / double(n), 0.0, 0.02);
+    FlightSampling bad;
+    bad.max_altitude_km = 0.0;
+    EXPECT_THROW(draw_flight_samples(1, 1, atm, bad), Error);
 }
 
 TEST(SeedSum, StepCosinesEqualTheSeedsDihedralFormula) {
