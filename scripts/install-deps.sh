@@ -28,6 +28,8 @@ PACKAGES=(
   libimgui-dev xvfb xauth
   # Python module, its tests, and the Blender add-on's
   pybind11-dev python3-dev python3-numpy python3-pytest blender
+  # the web package's tests (node's own test runner)
+  nodejs
 )
 
 missing=()
