@@ -261,16 +261,7 @@ void PlanetScene::set_uniforms(GLuint p, const PlanetView& v, const Basis& b) co
     r.eye_h = float(eye_r - atm.planet_radius_km);
     r.zenith = glm::vec3(eye / eye_r);
     r.sun = glm::normalize(glm::vec3(v.sun));
-    r.steps = model_.options().steps;
-    r.spacing = model_.options().uniform_steps ? sky::kStepsUniform : sky::kStepsGraded;
-    r.albedo = glm::vec3(atm.ground_albedo);
-    r.published_ground = options_.published_ground ? 1 : 0;
-    r.irradiance = glm::vec3(atm.sun_irradiance);
-    r.sun_cos_radius = float(std::cos(atm.sun_angular_radius_rad));
-    r.sun_disc_radiance =
-        options_.sun_disc
-            ? float(1.0 / (3.14159265358979323846 * atm.sun_angular_radius_rad * atm.sun_angular_radius_rad))
-            : 0.0f;
+    sky::set_scene_hd(r, model_, options_.published_ground, options_.sun_disc);
     const auto u1i = [&](const std::string& n, int x) { glUniform1i(loc(p, ("u_render." + n).c_str()), x); };
     const auto u1f = [&](const std::string& n, float x) { glUniform1f(loc(p, ("u_render." + n).c_str()), x); };
     const auto u3f = [&](const std::string& n, const glm::vec3& x) {

@@ -34,6 +34,9 @@ void evaluate_sky_split(const SkyModel& model, std::span<const SkySample> sample
 // Validates the settings (throws skybake::Error naming the flag) and sets up
 // the per-pixel parameters shared by the CPU and CUDA renderers.
 RenderHD make_render_hd(const SkyModel& model, const SkyRenderSettings& settings);
+// What the scene takes from the model: steps and spacing, ground albedo,
+// irradiance and sun disc (make_render_hd's, and the planet renderer's).
+void set_scene_hd(RenderHD& p, const SkyModel& model, bool published_ground, bool sun_disc);
 
 // The CPU pixel loop: shade(dir) -> linear RGB for every pixel with a view
 // direction, rows in parallel, with a progress bar. Pixels without a

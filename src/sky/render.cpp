@@ -61,6 +61,19 @@ glm::dvec3 shade_ray_exact(const Atmosphere& atm, const sky::RenderHD& p, const 
 
 namespace sky {
 
+void set_scene_hd(RenderHD& p, const SkyModel& model, bool published_ground, bool sun_disc) {
+    const Atmosphere& atm = model.atmosphere();
+    p.steps = model.options().steps;
+    p.spacing = model.options().uniform_steps ? kStepsUniform : kStepsGraded;
+    p.albedo = glm::vec3(atm.ground_albedo);
+    p.published_ground = published_ground ? 1 : 0;
+    p.irradiance = glm::vec3(atm.sun_irradiance);
+    p.sun_cos_radius = float(std::cos(atm.sun_angular_radius_rad));
+    p.sun_disc_radiance =
+        sun_disc ? float(1.0 / (3.14159265358979323846 * atm.sun_angular_radius_rad * atm.sun_angular_radius_rad))
+                 : 0.0f;
+}
+
 RenderHD make_render_hd(const SkyModel& model, const SkyRenderSettings& s) {
     const Atmosphere& atm = model.atmosphere();
     if (!(std::isfinite(s.altitude_km) && s.altitude_km >= 0.0 && s.altitude_km < 1e7))
@@ -91,15 +104,7 @@ RenderHD make_render_hd(const SkyModel& model, const SkyRenderSettings& s) {
     p.tan_half_fov = float(std::tan(0.5 * s.fov_deg * kDeg));
     p.width = s.width;
     p.height = s.height;
-    p.steps = model.options().steps;
-    p.spacing = model.options().uniform_steps ? sky::kStepsUniform : sky::kStepsGraded;
-    p.albedo = glm::vec3(atm.ground_albedo);
-    p.published_ground = s.published_ground ? 1 : 0;
-    p.irradiance = glm::vec3(atm.sun_irradiance);
-    p.sun_cos_radius = float(std::cos(atm.sun_angular_radius_rad));
-    p.sun_disc_radiance =
-        s.sun_disc ? float(1.0 / (3.14159265358979323846 * atm.sun_angular_radius_rad * atm.sun_angular_radius_rad))
-                   : 0.0f;
+    sky::set_scene_hd(p, model, s.published_ground, s.sun_disc);
     return p;
 }
 
