@@ -251,13 +251,15 @@ void bind_prt(py::module_& m) {
         py::arg("path"), "(mesh, transfer, albedo) of a baked mesh with its sidecar.");
     m.def(
         "export_prt_glsl",
-        [](int order, int channels, const std::string& function_name) {
+        [](int order, int channels, const std::string& function_name, bool es) {
             PrtShaderOptions o;
             o.function_name = function_name;
+            o.es = es;
             return export_prt_glsl(order, channels, o);
         },
         py::arg("order") = 3, py::arg("channels") = 1, py::arg("function_name") = "skybake_prt",
-        "GLSL of NAME_diffuse(prt[], light[], albedo) for engines.");
+        py::arg("es") = false,
+        "GLSL of NAME_diffuse(prt[], light[], albedo) for engines; es=True: GLSL ES 3.00 (WebGL 2), highp.");
 }
 
 } // namespace skybake::python

@@ -66,3 +66,5 @@ def test_asset_round_trip(tmp, sphere):
         skybake.load_prt(path)
     assert info.value.where == "sidecar"
     assert "skybake_prt_diffuse" in skybake.export_prt_glsl(3)
+    es = skybake.export_prt_glsl(3, es=True)
+    assert "highp vec3 skybake_prt_diffuse(" in es and "precision highp float;" in es

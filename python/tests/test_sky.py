@@ -71,6 +71,7 @@ def test_network_round_trip(tiny_net, tmp):
     b = skybake.Sky.network(back).evaluate(samples)
     np.testing.assert_array_equal(a, b)
     assert "skybake_sky" in tiny_net.export("glsl")
+    assert "highp vec3 skybake_sky(" in tiny_net.export("glsl-es")
     path.write_text("{\"format\": \"skybake-neural-sky\", \"version\": 1}")
     with pytest.raises(skybake.Error):
         skybake.load_neural_sky(path)
