@@ -59,8 +59,7 @@ protected:
 // core or newer, or OpenGL ES 3.0 or newer (what WebGL 2 runs on: the tests of
 // exported GLSL ES). Throws skybake::Error.
 enum class GlApi { Desktop, Es3 };
-std::unique_ptr<GlContext> create_headless_context();
-std::unique_ptr<GlContext> create_headless_context(GlApi api);
+std::unique_ptr<GlContext> create_headless_context(GlApi api = GlApi::Desktop);
 
 // [SECTION] RAII wrappers -------------------------------------------------------
 template <void (*Delete)(GLuint)>

@@ -183,8 +183,6 @@ void GlContext::check_es_version(const std::string& where) {
     es_ = true;
 }
 
-std::unique_ptr<GlContext> create_headless_context() { return create_headless_context(GlApi::Desktop); }
-
 std::unique_ptr<GlContext> create_headless_context(GlApi api) {
     return std::make_unique<EglContext>(api);
 }

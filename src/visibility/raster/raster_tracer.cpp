@@ -4,7 +4,6 @@
 #include "visibility/raster/raster_tracer.h"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
@@ -412,7 +411,6 @@ void RasterTracer::answer_near_field(const TraceChunk& chunk, std::vector<std::u
     const std::uint32_t wpv = rule.words_per_vertex;
     const float lookup = kLookupTexels * s_->texel, reach = kNearFieldTexels * s_->texel;
     const RayQueries& near = *s_->near;
-    std::atomic<std::uint64_t> contacts{0}, rays_traced{0};
     parallel_for(chunk.count, 16, [&](std::size_t b, std::size_t e) {
         std::vector<Ray> rays;
         std::vector<std::uint8_t> hit;
@@ -426,7 +424,6 @@ void RasterTracer::answer_near_field(const TraceChunk& chunk, std::vector<std::u
             segment.t_max = lookup;
             std::uint8_t contact = 0;
             near.occluded({&segment, 1}, {&contact, 1});
-            contacts += contact;
             std::uint32_t* mine = blocked.data() + i * wpv;
             const std::uint32_t* edge = blocked.data() + s_->edge_offset + i * wpv;
             rays.clear();
@@ -440,27 +437,22 @@ void RasterTracer::answer_near_field(const TraceChunk& chunk, std::vector<std::u
                 const bool whole = contact || get_bit(edge, j);
                 if (!whole && get_bit(mine, j))
                     continue; // the maps saw a blocker beyond the near field
+                if (whole)
+                    mine[j / 32] &= ~(1u << (j % 32)); // the ray's answer replaces the maps'
                 Ray r;
                 r.origin = o;
                 r.direction = x;
                 r.t_max = whole ? rule.t_max : reach;
                 rays.push_back(r);
-                which.push_back(j | (whole ? 0x80000000u : 0u));
+                which.push_back(j);
             }
             hit.resize(rays.size());
             near.occluded(rays, hit);
-            rays_traced += rays.size();
-            for (std::size_t q = 0; q < rays.size(); ++q) {
-                const std::uint32_t j = which[q] & 0x7fffffffu;
+            for (std::size_t q = 0; q < rays.size(); ++q)
                 if (hit[q])
-                    set_bit(mine, j);
-                else if (which[q] & 0x80000000u)
-                    mine[j / 32] &= ~(1u << (j % 32));
-            }
+                    set_bit(mine, which[q]);
         }
     });
-    near_contacts_ += contacts.load();
-    near_rays_ += rays_traced.load();
 }
 
 // The compute pass of both methods: the depth layers just drawn become the

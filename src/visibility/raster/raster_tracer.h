@@ -40,11 +40,6 @@ public:
     TraceMethod method() const override { return method_; }
     std::string device_name() const override;
     std::uint32_t resolution() const { return resolution_; }
-    // Directional: the vertices so far whose look-up segment met a surface
-    // (traced whole by the CPU tracer; see answer_near_field).
-    std::uint64_t near_contacts() const { return near_contacts_; }
-    // Directional: the rays traced so far by the CPU tracer (near field, edges, contacts).
-    std::uint64_t near_rays() const { return near_rays_; }
 
     void set_mesh(const Mesh& mesh, BackFaces back_faces = BackFaces::Occlude) override;
     std::uint32_t set_rule(const TraceRule& rule) override;
@@ -71,7 +66,6 @@ private:
     TraceMethod method_;
     std::uint32_t resolution_;
     std::unique_ptr<State> s_;
-    std::uint64_t near_contacts_ = 0, near_rays_ = 0;
 };
 
 // The directional method's near field (docs/baking.md, answer_near_field): the
