@@ -300,12 +300,15 @@ enum class SkyMethod : int {
 struct MultipleScatteringResolution {
     int r = 16;        // radius nodes of the orders grid, ≥ 2
     int mu = 32;       // view-cosine nodes per half (above / below the horizon), ≥ 2
-    int mu_s = 16;     // sun-cosine nodes, ≥ 2
+    int mu_s = 32;     // sun-cosine nodes, ≥ 2
     int nu = 8;        // view–sun cosine nodes, ≥ 2
     int sphere = 16;   // polar samples of the sphere integrals (azimuth: twice as many), ≥ 4
     int psi_r = 32, psi_mu_s = 32;           // Hillaire's ψms table, ≥ 2 each
     int irradiance_r = 8, irradiance_mu_s = 64; // sky irradiance table, ≥ 2 each
-    double mu_s_min = -0.2; // lowest sun cosine of the orders grid (Bruneton: cos 102°), in (−1, 0]
+    // Lowest sun cosine of the orders grid, in (−1, 0]: cos 120°, where the
+    // night sky is 1e-12 of the day's (Bruneton's cos 102° froze the sky at
+    // its twilight value below the sun's −11.5°).
+    double mu_s_min = -0.5;
 };
 
 // The folder of the table cache: skybake::cache_dir() (skybake/files.h):

@@ -3,7 +3,8 @@
 // C++ includes this file twice, with Real = float (the run-time look-ups of
 // sky_shared.h) and Real = double (the precomputation in scattering_orders.cpp),
 // and the planet renderer's shaders once with Real = float. The includer
-// defines Real and SB_REAL_SQRT (sqrtf for float, sqrt for double and GLSL).
+// defines Real and SB_REAL_SQRT, SB_REAL_LOG, SB_REAL_EXP (sqrtf, logf, expf for
+// float; sqrt, log, exp for double and GLSL).
 // No include guard, on purpose; what does not depend on Real is guarded.
 //
 // Bruneton E. A Qualitative and Quantitative Evaluation of 8 Clear Sky
@@ -45,6 +46,18 @@ SKYBAKE_HD_INLINE int grid_axis(Real x, int n, SB_OUT(Real) f) {
     return i;
 }
 
+// Bruneton 2017's sun-cosine coordinate (x = 0 at mu_s_min, 1 at the zenith),
+// denser near the horizon; constant below mu_s_min.
+SKYBAKE_HD_INLINE Real grid4_mus_coordinate(Real R0, Real Rt, Real mu_s_min, Real mu_s) {
+    Real H = hd_sqrt(Rt * Rt - R0 * R0);
+    Real dmin = Rt - R0;
+    Real dmax = H;
+    Real a = (distance_to_top(R0, mu_s, Rt) - dmin) / (dmax - dmin);
+    Real A = (distance_to_top(R0, mu_s_min, Rt) - dmin) / (dmax - dmin);
+    Real x = Real(1) - a / A;
+    return hd_clamp((x > Real(0) ? x : Real(0)) / (Real(1) + a), Real(0), Real(1));
+}
+
 // Bruneton 2017's mapping of a point to the unit-range coordinates of the 4D
 // grid (x = 0..1 on each axis), without the texel-centre offsets. ground = 1:
 // the ray meets the ground (the lower half of the μ axis).
@@ -69,11 +82,26 @@ SKYBAKE_HD_INLINE void grid4_coordinates(Real R0, Real Rt, Real mu_s_min, Real r
         Real dmax = rho + H;
         xmu = hd_clamp((d - dmin) / (dmax - dmin), Real(0), Real(1));
     }
-    Real dmin = Rt - R0;
-    Real dmax = H;
-    Real a = (distance_to_top(R0, mu_s, Rt) - dmin) / (dmax - dmin);
-    Real A = (distance_to_top(R0, mu_s_min, Rt) - dmin) / (dmax - dmin);
-    Real x = Real(1) - a / A;
-    xmus = hd_clamp((x > Real(0) ? x : Real(0)) / (Real(1) + a), Real(0), Real(1));
+    xmus = grid4_mus_coordinate(R0, Rt, mu_s_min, mu_s);
     xnu = hd_clamp((nu + Real(1)) * Real(0.5), Real(0), Real(1));
+}
+
+// Whether the μs cell [is, is + 1] of an axis of nmus nodes lies where the sun
+// is below the horizon (its upper node at μs ≤ 0). There the light falls by
+// orders of magnitude from node to node, nearly exponentially, and the grids
+// are interpolated geometrically along μs (grid4_mus_blend): linearly, the
+// night sky would keep a fraction of the twilight's light between nodes.
+SKYBAKE_HD_INLINE int grid4_mus_cell_below_horizon(Real R0, Real Rt, Real mu_s_min, int nmus, int is) {
+    return Real(is + 1) <= grid4_mus_coordinate(R0, Rt, mu_s_min, Real(0)) * Real(nmus - 1) + Real(1e-3) ? 1 : 0;
+}
+
+// The value between the μs nodes' values a (lower) and b at fraction f:
+// linear, or geometric in a cell below the horizon (values floored at 1e-30,
+// below any light the grids hold).
+SKYBAKE_HD_INLINE Real grid4_mus_blend(Real a, Real b, Real f, int below_horizon) {
+    if (below_horizon == 0)
+        return a + f * (b - a);
+    Real la = SB_REAL_LOG(a > Real(1e-30) ? a : Real(1e-30));
+    Real lb = SB_REAL_LOG(b > Real(1e-30) ? b : Real(1e-30));
+    return SB_REAL_EXP(la + f * (lb - la));
 }

@@ -13,14 +13,22 @@ namespace skybake::sky {
 
 #define Real float
 #define SB_REAL_SQRT sqrtf
+#define SB_REAL_LOG logf
+#define SB_REAL_EXP expf
 #include "sky/grid4_shared.h"
 #undef Real
 #undef SB_REAL_SQRT
+#undef SB_REAL_LOG
+#undef SB_REAL_EXP
 #define Real double
 #define SB_REAL_SQRT sqrt
+#define SB_REAL_LOG log
+#define SB_REAL_EXP exp
 #include "sky/grid4_shared.h"
 #undef Real
 #undef SB_REAL_SQRT
+#undef SB_REAL_LOG
+#undef SB_REAL_EXP
 
 // The unit-range coordinates of a point of the 4D grid (grid4_coordinates).
 template <class T>

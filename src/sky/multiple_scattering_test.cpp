@@ -22,7 +22,7 @@ MultipleScatteringResolution test_resolution() {
     MultipleScatteringResolution r;
     r.r = 12;
     r.mu = 24;
-    r.mu_s = 12;
+    r.mu_s = 20; // over the default −30° to 90°
     r.nu = 6;
     r.sphere = 8;
     return r;
@@ -243,6 +243,10 @@ TEST(MultipleScattering, HillaireIsCloseToTheOrdersByDay) {
 TEST(MultipleScattering, TwilightZenithIsNotBlack) {
     SkyModelOptions o;
     o.multiple = test_resolution();
+    // The light that reaches a shadowed column comes from a narrow band of
+    // lit air near the horizon: 8 polar samples miss most of it.
+    o.multiple.sphere = 16;
+    o.multiple.nu = 8;
     const SkyModel m(earth_multiple(), o);
     const double cs = std::sin(-8 * kDeg);
     const glm::dvec3 single = SkyModel(atmosphere_preset("earth")).radiance_at_radius(6360.0, 1.0, cs, cs, SkyMethod::Exact);
@@ -252,6 +256,28 @@ TEST(MultipleScattering, TwilightZenithIsNotBlack) {
     // Nautical twilight: some 1e-5 to 1e-4 of the noon zenith.
     EXPECT_GT(total.z, 1e-5 * noon.z);
     EXPECT_LT(total.z, 1e-3 * noon.z);
+}
+
+// The night goes dark: the zenith from sea level falls with every degree the
+// sun sinks, down to the grid's lowest sun (−30°), to a millionth of the
+// nautical twilight's (−8°); nothing is frozen at a twilight value.
+TEST(MultipleScattering, TheNightGoesDark) {
+    SkyModelOptions o;
+    o.multiple = test_resolution();
+    const SkyModel m(earth_multiple(), o);
+    auto zenith = [&](double sun_deg) {
+        const double cs = std::sin(sun_deg * kDeg);
+        return m.radiance_at_radius(6360.0, 1.0, cs, cs, SkyMethod::Tables);
+    };
+    glm::dvec3 prev = zenith(-2.0);
+    for (int deg = -3; deg >= -30; --deg) {
+        const glm::dvec3 L = zenith(deg);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_LT(L[c], prev[c]) << deg << "°, channel " << c;
+        prev = L;
+    }
+    for (int c = 0; c < 3; ++c)
+        EXPECT_LT(zenith(-30.0)[c], 1e-6 * zenith(-8.0)[c]) << c;
 }
 
 // Sky irradiance: zero at night, rising with the sun, blue; on the ground it

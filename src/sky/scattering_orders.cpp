@@ -57,9 +57,13 @@ SphereRule sphere_rule(int n) {
 }
 
 // The 16 nodes and weights of a quadrilinear look-up.
+// The 16 nodes of a quadrilinear look-up: weights over (r, μ, ν) for each of
+// the two μs nodes (s = bit 1 of the tap), blended along μs by grid4_mus_blend.
 struct Taps {
     std::size_t index[16];
     double weight[16];
+    double fs = 0.0;
+    int below_horizon = 0;
 };
 
 // One axis of a look-up: the lower node and the fraction.
@@ -83,9 +87,11 @@ Taps taps(const Grid4Shape& g, int ground, Axis r, Axis m, Axis s_, Axis n_) {
         for (int b = 0; b < 2; ++b)
             for (int s = 0; s < 2; ++s)
                 for (int n = 0; n < 2; ++n, ++q) {
-                    t.weight[q] = (a ? fr : 1.0 - fr) * (b ? fm : 1.0 - fm) * (s ? fs : 1.0 - fs) * (n ? fn : 1.0 - fn);
+                    t.weight[q] = (a ? fr : 1.0 - fr) * (b ? fm : 1.0 - fm) * (n ? fn : 1.0 - fn);
                     t.index[q] = std::size_t(grid4_index(g.nmu, g.nmus, g.nnu, ir + a, ground, im + b, is + s, in + n));
                 }
+    t.fs = fs;
+    t.below_horizon = grid4_mus_cell_below_horizon(g.R0, g.Rt, g.mu_s_min, g.nmus, is);
     return t;
 }
 
@@ -94,9 +100,12 @@ Taps taps(const Grid4Shape& g, const Grid4Coord<double>& c) {
 }
 
 glm::dvec3 apply_taps(const Taps& t, const std::vector<glm::dvec3>& v, std::size_t stride = 1, std::size_t j = 0) {
-    glm::dvec3 s(0.0);
+    glm::dvec3 at[2] = {glm::dvec3(0.0), glm::dvec3(0.0)};
     for (int q = 0; q < 16; ++q)
-        s += t.weight[q] * v[t.index[q] * stride + j];
+        at[(q >> 1) & 1] += t.weight[q] * v[t.index[q] * stride + j];
+    glm::dvec3 s;
+    for (int c = 0; c < 3; ++c)
+        s[c] = grid4_mus_blend(at[0][c], at[1][c], t.fs, t.below_horizon);
     return s;
 }
 

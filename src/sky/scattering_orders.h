@@ -19,7 +19,7 @@ namespace skybake::sky {
 // The node layout of the orders grid, and its (r, μ, μs, ν) at each node.
 struct Grid4Shape {
     int nr = 2, nmu = 2, nmus = 2, nnu = 2; // nmu per half
-    double R0 = 6360.0, Rt = 6420.0, mu_s_min = -0.2;
+    double R0 = 6360.0, Rt = 6420.0, mu_s_min = -0.5;
 
     std::size_t nodes() const { return std::size_t(nr) * 2u * std::size_t(nmu) * std::size_t(nmus) * std::size_t(nnu); }
     // The geometry of node `index` (grid4_index order). ν is clamped to the

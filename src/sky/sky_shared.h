@@ -74,7 +74,7 @@ struct ComponentHD {
 // floats, node-centred: coordinate x in [0, 1] maps to index x (n − 1).
 struct MultipleHD {
     int method SB_INIT(kMultipleNone);
-    float mu_s_min SB_INIT(-0.2f); // the orders grid's lowest sun cosine; below it, values are those at mu_s_min
+    float mu_s_min SB_INIT(-0.5f); // the orders grid's lowest sun cosine; below it, values are those at mu_s_min
     // Orders ≥ 2 of scattered radiance (1/sr per unit sun irradiance) over the
     // grid nr × (2 nmu) × nmus × nnu (see grid4_index).
     SB_DATA orders SB_INIT(0);
@@ -518,17 +518,23 @@ SKYBAKE_HD_INLINE vec3 orders_lookup(SB_IN(MultipleHD) m, float R0, float Rt, fl
     int im = grid_axis(xmu, m.nmu, fm);
     int is = grid_axis(xmus, m.nmus, fs);
     int inu = grid_axis(xnu, m.nnu, fn);
-    vec3 sum = vec3(0.0f);
-    for (int a = 0; a < 2; ++a)
-        for (int b = 0; b < 2; ++b)
-            for (int s = 0; s < 2; ++s)
+    // Trilinear in (r, μ, ν) at the two μs nodes, then blended along μs
+    // (geometrically below the horizon: grid4_mus_blend).
+    vec3 at[2];
+    for (int s = 0; s < 2; ++s) {
+        vec3 sum = vec3(0.0f);
+        for (int a = 0; a < 2; ++a)
+            for (int b = 0; b < 2; ++b)
                 for (int n = 0; n < 2; ++n) {
-                    float w = (a == 1 ? fr : 1.0f - fr) * (b == 1 ? fm : 1.0f - fm) * (s == 1 ? fs : 1.0f - fs) *
-                              (n == 1 ? fn : 1.0f - fn);
+                    float w = (a == 1 ? fr : 1.0f - fr) * (b == 1 ? fm : 1.0f - fm) * (n == 1 ? fn : 1.0f - fn);
                     sum += w * SB_MS_RGB(m.orders, grid4_index(m.nmu, m.nmus, m.nnu, ir + a, lower, im + b, is + s,
                                                                inu + n));
                 }
-    return sum;
+        at[s] = sum;
+    }
+    int below = grid4_mus_cell_below_horizon(R0, Rt, m.mu_s_min, m.nmus, is);
+    return vec3(grid4_mus_blend(at[0].x, at[1].x, fs, below), grid4_mus_blend(at[0].y, at[1].y, fs, below),
+                grid4_mus_blend(at[0].z, at[1].z, fs, below));
 }
 
 // Bilinear look-up in an RGB table over altitude (uniform, ground to top) and

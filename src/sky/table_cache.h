@@ -28,7 +28,7 @@ namespace skybake::sky {
 
 // Bump whenever the file layout or the tables' algorithms change (results of
 // an older build must not be read back as this build's).
-inline constexpr unsigned kTableCacheFormat = 1;
+inline constexpr unsigned kTableCacheFormat = 2; // 2: orders interpolated geometrically in μs below the horizon
 
 struct CachedTables {
     std::vector<float> main;       // MultipleHD::orders or MultipleHD::psi

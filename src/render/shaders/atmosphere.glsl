@@ -20,6 +20,8 @@ uniform samplerBuffer u_ms;
 #define SB_MS_RGB(p, i) vec3(texelFetch(u_ms, 3 * ((p) + (i))).r, texelFetch(u_ms, 3 * ((p) + (i)) + 1).r, texelFetch(u_ms, 3 * ((p) + (i)) + 2).r)
 #define Real float
 #define SB_REAL_SQRT sqrt
+#define SB_REAL_LOG log
+#define SB_REAL_EXP exp
 
 #define SB_SKY_TEMPLATE
 #define SB_SKY_PARAM int sky_fn
