@@ -28,8 +28,8 @@ PACKAGES=(
   libimgui-dev xvfb xauth
   # Python module, its tests, and the Blender add-on's
   pybind11-dev python3-dev python3-numpy python3-pytest blender
-  # the web package's tests (node's own test runner)
-  nodejs
+  # the web package: node's own test runner, esbuild's bundle, headless Chromium (WebGL 2 on SwiftShader)
+  nodejs chromium
 )
 
 missing=()
@@ -37,6 +37,9 @@ for p in "${PACKAGES[@]}"; do
   status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
   [[ "$status" == "install ok installed" ]] || missing+=("$p")
 done
+
+# npm: Debian's package where node is Debian's; a node that brings its own npm needs none.
+command -v npm >/dev/null 2>&1 || dpkg-query -W -f='${Status}' npm 2>/dev/null | grep -q "install ok installed" || missing+=(npm)
 
 if [[ ${#missing[@]} -eq 0 ]]; then
   echo "install-deps: all ${#PACKAGES[@]} packages present"

@@ -1,0 +1,38 @@
+// Types of skybake-web/three.
+import type { Mesh, Material, BoxGeometry, ShaderMaterial, IUniform, Vector3 } from 'three';
+import type { NeuralSky as Network, NeuralSkyJson } from './neural_sky.js';
+import type { ShLight } from './index.js';
+
+/** A drop-in for three.js's Sky: set material.uniforms.sunPosition (or setSun()). */
+export declare class NeuralSky extends Mesh<BoxGeometry, ShaderMaterial> {
+  /**
+   * @param weights the weights file of `skybake sky train` (text, parsed JSON or a skybake-web NeuralSky)
+   * @param glsl `skybake sky export` of the same file with `--format glsl-es`
+   */
+  constructor(weights: string | NeuralSkyJson | Network, glsl: string, options?: { order?: number });
+  readonly isSky: true;
+  readonly network: Network;
+  /** Uniforms: sunPosition, up (default +y), density (1 at sea level), sunIrradiance (scale of the output). */
+  setSun(elevationDeg: number, azimuthDeg: number): this;
+  sunAngles(): { elevation: number; azimuth: number };
+  /** The sky's SH light for the current sun, times sunIrradiance. */
+  shLight(): ShLight;
+}
+
+export interface SkybakeLightingOptions {
+  /** 'prt': the _prt_i attributes through prtGlsl; 'ao': an AO attribute times the unshadowed order-2 light. */
+  mode?: 'prt' | 'ao';
+  /** `skybake prt export BAKED.glb --format glsl-es` */
+  prtGlsl?: string;
+  /** Number of _prt_i attributes (the sidecar's "attributes"). */
+  attributes?: number;
+  order?: number;
+  /** The AO attribute: '_ao' (glTF _AO, lower-cased by GLTFLoader) or 'color' (COLOR_0's red). */
+  aoAttribute?: string;
+  albedo?: [number, number, number];
+}
+
+export declare function skybakeLighting(
+  material: Material,
+  options?: SkybakeLightingOptions,
+): { uniforms: Record<string, IUniform>; update(light: ShLight): void };

@@ -1,0 +1,172 @@
+// skybake-web/three: skybake's neural sky and baked sky light in three.js.
+//
+//   NeuralSky      a drop-in for three.js's Sky (examples/jsm/objects/Sky.js):
+//                  a box around the camera, drawn at the far plane, whose
+//                  fragments run the network of `skybake sky train`. Set the
+//                  sun as with Sky: material.uniforms.sunPosition (or setSun()).
+//   skybakeLighting an onBeforeCompile hook for a mesh's material that adds the
+//                  sky's SH light through the baked transfer (_PRT_i) or the
+//                  baked AO (_AO, COLOR_0) times the unshadowed SH light.
+//
+// The shader code is not written here: the network's GLSL is the output of
+// `skybake sky export W.json --format glsl-es`, the transfer's dot product that
+// of `skybake prt export BAKED.glb --format glsl-es`, the generators that
+// write every other language. The weights file itself drives the per-frame
+// SH projection in JavaScript (SkyProjector).
+import { BackSide, BoxGeometry, Mesh, ShaderMaterial, Vector3 } from 'three';
+import { NeuralSky as Network } from './neural_sky.js';
+import { SkyProjector, horizonRule } from './sky_sh.js';
+
+const VERTEX = /* glsl */ `
+varying vec3 vWorldPosition;
+void main() {
+  vec4 worldPosition = modelMatrix * vec4(position, 1.0);
+  vWorldPosition = worldPosition.xyz;
+  gl_Position = projectionMatrix * modelViewMatrix * vec4(position, 1.0);
+  gl_Position.z = gl_Position.w; // on the far plane
+}
+`;
+
+// skybake_sky() comes first (the exported function), then this.
+const FRAGMENT = /* glsl */ `
+varying vec3 vWorldPosition;
+uniform vec3 sunPosition;
+uniform vec3 up;
+uniform float density;
+uniform float sunIrradiance;
+void main() {
+  vec3 v = normalize(vWorldPosition - cameraPosition);
+  vec3 s = normalize(sunPosition);
+  vec3 u = normalize(up);
+  vec3 L = skybake_sky(clamp(dot(v, u), -1.0, 1.0), clamp(dot(v, s), -1.0, 1.0), clamp(dot(s, u), -1.0, 1.0), density);
+  gl_FragColor = vec4(max(L, vec3(0.0)) * sunIrradiance, 1.0);
+  #include <tonemapping_fragment>
+  #include <colorspace_fragment>
+}
+`;
+
+function checkGlsl(glsl, name) {
+  if (typeof glsl !== 'string' || !new RegExp(`\\b${name}\\s*\\(`).test(glsl))
+    throw new Error(`skybake: the shader text has no ${name}() (write it with \`skybake sky export W.json --format glsl-es\`)`);
+}
+
+export class NeuralSky extends Mesh {
+  // weights: the weights file of `skybake sky train` (text, object or a
+  // skybake-web NeuralSky); glsl: `skybake sky export` of the same file with
+  // --format glsl-es. options.order: the SH order of shLight() (default 3).
+  constructor(weights, glsl, { order = 3 } = {}) {
+    checkGlsl(glsl, 'skybake_sky');
+    const network = weights instanceof Network ? weights : new Network(weights);
+    const material = new ShaderMaterial({
+      name: 'SkybakeNeuralSky',
+      uniforms: {
+        sunPosition: { value: new Vector3(0, 1, 0) },
+        up: { value: new Vector3(0, 1, 0) },
+        density: { value: 1 },
+        sunIrradiance: { value: 1 },
+      },
+      vertexShader: VERTEX,
+      fragmentShader: glsl + FRAGMENT,
+      side: BackSide,
+      depthWrite: false,
+    });
+    super(new BoxGeometry(1, 1, 1), material);
+    this.isSky = true;
+    this.type = 'NeuralSky';
+    this.network = network;
+    this.projector = new SkyProjector(order, horizonRule());
+  }
+
+  // The sun at elevation and azimuth (degrees; azimuth from +z towards +x,
+  // the glTF frame of skybake's SH).
+  setSun(elevationDeg, azimuthDeg) {
+    const e = (elevationDeg * Math.PI) / 180, a = (azimuthDeg * Math.PI) / 180;
+    this.material.uniforms.sunPosition.value.set(Math.cos(e) * Math.sin(a), Math.sin(e), Math.cos(e) * Math.cos(a));
+    return this;
+  }
+
+  // The sun's elevation and azimuth (degrees) from sunPosition.
+  sunAngles() {
+    const s = this.material.uniforms.sunPosition.value.clone().normalize();
+    return {
+      elevation: (Math.asin(Math.max(-1, Math.min(1, s.y))) * 180) / Math.PI,
+      azimuth: (Math.atan2(s.x, s.z) * 180) / Math.PI,
+    };
+  }
+
+  // The sky's light in SH for the current sun (skybake's convention, glTF
+  // frame), scaled by sunIrradiance: { order, coefficients: [[r, g, b], ...] }.
+  shLight() {
+    const { elevation, azimuth } = this.sunAngles();
+    const u = this.material.uniforms;
+    const light = this.projector.project(this.network, elevation, azimuth, u.density.value);
+    const k = u.sunIrradiance.value;
+    light.coefficients = light.coefficients.map((c) => [c[0] * k, c[1] * k, c[2] * k]);
+    return light;
+  }
+}
+
+// Adds the sky's SH light to `material` (MeshStandardMaterial,
+// MeshLambertMaterial, ...) through the baked data of the geometry it draws:
+//   mode 'prt': the transfer attributes _prt_0.._prt_{M-1} (three.js's
+//               GLTFLoader lower-cases glTF's _PRT_i) and prtGlsl, the text of
+//               `skybake prt export BAKED.glb --format glsl-es`;
+//   mode 'ao':  the AO attribute `aoAttribute` (default '_ao'; 'color' reads
+//               COLOR_0's red) times the unshadowed SH irradiance, order 2.
+// The light is added as emissive radiance (albedo × light) so that three's
+// own lights (the sun) keep working. Returns an object whose update(light)
+// takes NeuralSky.shLight()'s result each frame.
+export function skybakeLighting(material, { mode = 'prt', prtGlsl, attributes = 0, order = 3, aoAttribute = '_ao', albedo = [1, 1, 1] } = {}) {
+  const count = (order + 1) * (order + 1);
+  if (mode === 'ao' && order < 2) throw new Error('skybake: ao lighting needs an SH light of order 2 or more');
+  const uniformCount = mode === 'prt' ? count : 9;
+  const uniforms = {
+    skybakeLight: { value: Array.from({ length: uniformCount }, () => new Vector3()) },
+    skybakeAlbedo: { value: new Vector3(...albedo) },
+  };
+  if (mode === 'prt') {
+    checkGlsl(prtGlsl, 'skybake_prt_diffuse');
+    if (!Number.isInteger(attributes) || attributes < 1) throw new Error('skybake: prt lighting needs the number of _prt_i attributes');
+  } else if (mode !== 'ao') {
+    throw new Error(`skybake: lighting mode '${mode}' is not 'prt' or 'ao'`);
+  }
+  material.onBeforeCompile = (shader) => {
+    Object.assign(shader.uniforms, uniforms);
+    let decl = `uniform vec3 skybakeLight[${uniformCount}];\nuniform vec3 skybakeAlbedo;\nvarying vec3 vSkybakeSky;\n`;
+    let body;
+    if (mode === 'prt') {
+      for (let i = 0; i < attributes; ++i) decl += `attribute vec4 _prt_${i};\n`;
+      // skybake_prt_diffuse(vec4 prt[M], vec3 light[coefficients], vec3 albedo);
+      // with 3 channels each reads its own component of the light.
+      body = `{ vec4 skybake_t[${attributes}] = vec4[${attributes}](${Array.from({ length: attributes }, (_, i) => `_prt_${i}`).join(', ')});
+        vSkybakeSky = skybake_prt_diffuse(skybake_t, skybakeLight, skybakeAlbedo); }`;
+      decl += prtGlsl;
+    } else {
+      const ao = aoAttribute === 'color' ? 'color.r' : aoAttribute;
+      if (aoAttribute !== 'color') decl += `attribute float ${aoAttribute};\n`;
+      // Irradiance of an order-2 SH light on the normal (Ramamoorthi & Hanrahan's
+      // clamped-cosine factors π, 2π/3, π/4), radiance = albedo/π × E × AO.
+      body = `{ vec3 n = normalize(mat3(modelMatrix) * objectNormal);
+        float x = n.x, y = n.y, z = n.z;
+        vec3 E = 3.14159265 * 0.282095 * skybakeLight[0]
+          + 2.0943951 * 0.488603 * (y * skybakeLight[1] + z * skybakeLight[2] + x * skybakeLight[3])
+          + 0.785398163 * (1.092548 * x * y * skybakeLight[4] + 1.092548 * y * z * skybakeLight[5]
+             + 0.315392 * (3.0 * z * z - 1.0) * skybakeLight[6] + 1.092548 * x * z * skybakeLight[7]
+             + 0.546274 * (x * x - y * y) * skybakeLight[8]);
+        vSkybakeSky = skybakeAlbedo / 3.14159265 * max(E, vec3(0.0)) * ${ao}; }`;
+    }
+    shader.vertexShader = decl + shader.vertexShader.replace('#include <begin_vertex>', `#include <begin_vertex>\n${body}`);
+    shader.fragmentShader = 'varying vec3 vSkybakeSky;\n' +
+      shader.fragmentShader.replace('#include <emissivemap_fragment>', '#include <emissivemap_fragment>\ntotalEmissiveRadiance += vSkybakeSky;');
+  };
+  material.customProgramCacheKey = () => `skybake-${mode}-${attributes}-${order}-${aoAttribute}`;
+  material.needsUpdate = true;
+  return {
+    uniforms,
+    update(light) {
+      light.coefficients.forEach((c, i) => {
+        if (i < uniforms.skybakeLight.value.length) uniforms.skybakeLight.value[i].set(c[0], c[1], c[2]);
+      });
+    },
+  };
+}
