@@ -4,7 +4,7 @@
 // horizon towards and away from the sun (docs/sky.md, "Error over a grid of
 // views", is this program's output).
 //
-//   twilight_report [--paths N] [--reference FILE] [--nmus N] [--mu-s-min C] [--orders N]
+//   twilight_report [--paths N] [--reference FILE] [--nmus N] [--mu-s-min C] [--sphere N] [--nu N] [--orders N]
 //   twilight_report --night [--nmus N] [--mu-s-min C] [--orders N]
 //   (--altitude H and --sun S keep only the views at H km, at S°)
 //
@@ -17,7 +17,7 @@
 // left out. Columns: % error of the total radiance, R, G, B, and three
 // standard errors of the reference in % of it; a channel whose three
 // standard errors exceed 30% of the reference (deep twilight, where paths
-// seldom find the lit air) is not compared ("·"). Built as a tool, not a test:
+// seldom find the lit air), or that is 0 (none did), is not compared ("·"). Built as a tool, not a test:
 // the reference takes minutes. --night prints instead the orders' zenith
 // radiance at sea level for suns from 0 to −30° (how the night falls).
 #include <cmath>
@@ -69,6 +69,17 @@ std::vector<View> grid(double R0, double Rt) {
     return views;
 }
 
+SkyModel multiple_model(const Atmosphere& earth, MultipleScatteringMethod method, int orders,
+                        const MultipleScatteringResolution& res) {
+    Atmosphere atm = earth;
+    atm.scattering = Scattering::Multiple;
+    atm.multiple_method = method;
+    atm.scattering_orders = orders;
+    SkyModelOptions options;
+    options.multiple = res;
+    return SkyModel(atm, options);
+}
+
 std::string key(const View& v) { return fmt::format("{} {} {}", v.altitude_km, v.sun_deg, v.kind); }
 
 } // namespace
@@ -97,6 +108,10 @@ int main(int argc, char** argv) {
             reference_file = value;
         else if (a == "--nmus")
             res.mu_s = std::atoi(value);
+        else if (a == "--sphere")
+            res.sphere = std::atoi(value);
+        else if (a == "--nu")
+            res.nu = std::atoi(value);
         else if (a == "--mu-s-min")
             res.mu_s_min = std::atof(value);
         else if (a == "--altitude")
@@ -119,12 +134,7 @@ int main(int argc, char** argv) {
             if ((only_altitude < 0.0 || v.altitude_km == only_altitude) && (only_sun > 999.0 || v.sun_deg == only_sun))
                 views.push_back(v);
         if (night) {
-            Atmosphere atm = earth;
-            atm.scattering = Scattering::Multiple;
-            atm.scattering_orders = orders;
-            SkyModelOptions options;
-            options.multiple = res;
-            const SkyModel model(atm, options);
+            const SkyModel model = multiple_model(earth, MultipleScatteringMethod::Orders, orders, res);
             std::printf("| sun | zenith radiance at sea level (R, G, B) |\n|---|---|\n");
             for (int deg = 0; deg >= -30; --deg) {
                 const double mu_s = std::cos((90.0 - deg) * kDeg);
@@ -169,14 +179,8 @@ int main(int argc, char** argv) {
             }
         }
 
-        Atmosphere atm = earth;
-        atm.scattering = Scattering::Multiple;
-        atm.scattering_orders = orders;
-        SkyModelOptions options;
-        options.multiple = res;
-        const SkyModel by_orders(atm, options);
-        atm.multiple_method = MultipleScatteringMethod::Hillaire;
-        const SkyModel by_hillaire(atm, options);
+        const SkyModel by_orders = multiple_model(earth, MultipleScatteringMethod::Orders, orders, res);
+        const SkyModel by_hillaire = multiple_model(earth, MultipleScatteringMethod::Hillaire, orders, res);
 
         std::printf("| altitude | sun | view | reference total (R, G, B) | orders %d, %% | hillaire, %% | 3σ of the reference, %% |\n",
                     orders);
@@ -187,7 +191,8 @@ int main(int argc, char** argv) {
             const glm::dvec3 o = by_orders.radiance_at_radius(R0 + v.altitude_km, v.mu, v.nu, v.mu_s, SkyMethod::Exact);
             const glm::dvec3 hl =
                 by_hillaire.radiance_at_radius(R0 + v.altitude_km, v.mu, v.nu, v.mu_s, SkyMethod::Exact);
-            auto resolved = [&](int c) { return t[c] > 0.0 && 3.0 * e[c] <= 0.3 * t[c]; };
+            // A standard error of 0: no path found light of order 2 or more.
+            auto resolved = [&](int c) { return e[c] > 0.0 && 3.0 * e[c] <= 0.3 * t[c]; };
             auto pct = [&](const glm::dvec3& x) {
                 std::string s;
                 for (int c = 0; c < 3; ++c)

@@ -302,7 +302,7 @@ struct MultipleScatteringResolution {
     int mu = 32;       // view-cosine nodes per half (above / below the horizon), ≥ 2
     int mu_s = 32;     // sun-cosine nodes, ≥ 2
     int nu = 8;        // view–sun cosine nodes, ≥ 2
-    int sphere = 16;   // polar samples of the sphere integrals (azimuth: twice as many), ≥ 4
+    int sphere = 16;   // polar samples of the sphere integrals, Gauss–Legendre in cos θ, half on each side of the horizon (an odd count loses one); azimuth: twice as many; ≥ 4
     int psi_r = 32, psi_mu_s = 32;           // Hillaire's ψms table, ≥ 2 each
     int irradiance_r = 8, irradiance_mu_s = 64; // sky irradiance table, ≥ 2 each
     // Lowest sun cosine of the orders grid, in (−1, 0]: cos 120°, where the

@@ -91,8 +91,9 @@ SKYBAKE_HD_INLINE void grid4_coordinates(Real R0, Real Rt, Real mu_s_min, Real r
 // orders of magnitude from node to node, nearly exponentially, and the grids
 // are interpolated geometrically along μs (grid4_mus_blend): linearly, the
 // night sky would keep a fraction of the twilight's light between nodes.
-SKYBAKE_HD_INLINE int grid4_mus_cell_below_horizon(Real R0, Real Rt, Real mu_s_min, int nmus, int is) {
-    return Real(is + 1) <= grid4_mus_coordinate(R0, Rt, mu_s_min, Real(0)) * Real(nmus - 1) + Real(1e-3) ? 1 : 0;
+// x_horizon: grid4_mus_coordinate of μs = 0 (a constant of the grid).
+SKYBAKE_HD_INLINE int grid4_mus_cell_below_horizon(Real x_horizon, int nmus, int is) {
+    return Real(is + 1) <= x_horizon * Real(nmus - 1) + Real(1e-3) ? 1 : 0;
 }
 
 // The value between the μs nodes' values a (lower) and b at fraction f:
@@ -101,6 +102,11 @@ SKYBAKE_HD_INLINE int grid4_mus_cell_below_horizon(Real R0, Real Rt, Real mu_s_m
 SKYBAKE_HD_INLINE Real grid4_mus_blend(Real a, Real b, Real f, int below_horizon) {
     if (below_horizon == 0)
         return a + f * (b - a);
+    // At a node (the precomputation's own look-ups), no logarithms.
+    if (f < Real(1e-6))
+        return a;
+    if (f > Real(1) - Real(1e-6))
+        return b;
     Real la = SB_REAL_LOG(a > Real(1e-30) ? a : Real(1e-30));
     Real lb = SB_REAL_LOG(b > Real(1e-30) ? b : Real(1e-30));
     return SB_REAL_EXP(la + f * (lb - la));

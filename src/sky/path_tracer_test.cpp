@@ -9,35 +9,12 @@
 #include "skybake/error.h"
 #include "skybake/sky.h"
 #include "skybake/sky_path_tracer.h"
+#include "sky/quadrature.h"
 
 namespace skybake {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-// Gauss–Legendre nodes and weights on [0, 1] (Newton on P_n).
-void gauss_legendre01(int n, std::vector<double>& x, std::vector<double>& w) {
-    x.assign(std::size_t(n), 0.0);
-    w.assign(std::size_t(n), 0.0);
-    for (int i = 0; i < n; ++i) {
-        double z = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 1.0;
-        for (int it = 0; it < 100; ++it) {
-            double p0 = 1.0, p1 = z;
-            for (int k = 2; k <= n; ++k) {
-                const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / k;
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = n * (z * p1 - p0) / (z * z - 1.0);
-            const double dz = p1 / dp;
-            z -= dz;
-            if (std::abs(dz) < 1e-15)
-                break;
-        }
-        x[std::size_t(i)] = 0.5 * (1.0 - z);
-        w[std::size_t(i)] = 1.0 / ((1.0 - z * z) * dp * dp);
-    }
-}
 
 // Chandrasekhar's H-function of isotropic scattering with albedo ϖ, from the
 // fixed point of 1/H(μ) = √(1 − ϖ) + (ϖ/2) ∫₀¹ μ' H(μ') / (μ + μ') dμ'
@@ -45,7 +22,7 @@ void gauss_legendre01(int n, std::vector<double>& x, std::vector<double>& w) {
 class HFunction {
 public:
     explicit HFunction(double albedo, int nodes = 96) : w_(albedo) {
-        gauss_legendre01(nodes, x_, q_);
+        sky::gauss_legendre_unit(nodes, x_, q_);
         h_.assign(x_.size(), 1.0);
         for (int it = 0; it < 20000; ++it) {
             double change = 0.0;
@@ -74,7 +51,7 @@ private:
 TEST(ChandrasekharH, MeetsItsMomentIdentity) {
     // H(0) = 1 and α0 = ∫₀¹ H dμ = (2/ϖ)(1 − √(1 − ϖ)) (Radiative Transfer, ch. V, eq. 19).
     std::vector<double> x, w;
-    gauss_legendre01(200, x, w);
+    sky::gauss_legendre_unit(200, x, w);
     for (const double albedo : {0.5, 0.9, 0.99}) {
         const HFunction h(albedo);
         EXPECT_NEAR(h(0.0), 1.0, 1e-9) << albedo;

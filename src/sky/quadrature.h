@@ -25,6 +25,33 @@ struct GaussKronrod15 {
                                      0.381830050505118944950369775488975, 0.417959183673469387755102040816327};
 };
 
+// Gauss–Legendre nodes and weights on [0, 1] (Newton on P_n from the
+// Chebyshev guesses; converged to double precision).
+inline void gauss_legendre_unit(int n, std::vector<double>& x, std::vector<double>& w) {
+    x.assign(std::size_t(n), 0.0);
+    w.assign(std::size_t(n), 0.0);
+    for (int i = 0; i < n; ++i) {
+        double z = std::cos(3.14159265358979323846 * (double(i) + 0.75) / (double(n) + 0.5)), dp = 1.0;
+        for (int it = 0; it < 100; ++it) {
+            double p0 = 1.0, p1 = z;
+            for (int k = 2; k <= n; ++k) {
+                const double p2 = ((2.0 * k - 1.0) * z * p1 - (k - 1.0) * p0) / double(k);
+                p0 = p1;
+                p1 = p2;
+            }
+            if (n == 1)
+                p0 = 1.0, p1 = z;
+            dp = double(n) * (z * p1 - p0) / (z * z - 1.0);
+            const double dz = p1 / dp;
+            z -= dz;
+            if (std::abs(dz) < 1e-15)
+                break;
+        }
+        x[std::size_t(i)] = 0.5 * (1.0 - z);
+        w[std::size_t(i)] = 1.0 / ((1.0 - z * z) * dp * dp);
+    }
+}
+
 inline double max_abs(const glm::dvec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); }
 
 // One panel: Kronrod estimate, and |Kronrod − Gauss| as the error.

@@ -25,6 +25,7 @@
 
 #include "core/parallel.h"
 #include "core/progress.h"
+#include "sky/quadrature.h"
 #include "sky/transmittance_table.h"
 
 namespace skybake::sky {
@@ -42,17 +43,26 @@ struct SphereRule {
     std::vector<double> weight;
 };
 
+// The sphere integrals' rule: n polar nodes, Gauss–Legendre in cos θ on each
+// side of the horizon (n/2 each; the nodes crowd towards the horizon, where
+// a point's incoming light steps from the lit sky to the ground and where a
+// shadowed point's light comes from at twilight) × 2n azimuths.
 SphereRule sphere_rule(int n) {
     SphereRule s;
+    std::vector<double> x, w;
+    const int half = std::max(1, n / 2);
+    gauss_legendre_unit(half, x, w);
     const double d = kPiD / double(n);
-    for (int i = 0; i < n; ++i) {
-        const double th = (double(i) + 0.5) * d;
-        for (int j = 0; j < 2 * n; ++j) {
-            const double ph = (double(j) + 0.5) * d;
-            s.dir.emplace_back(std::cos(ph) * std::sin(th), std::sin(ph) * std::sin(th), std::cos(th));
-            s.weight.push_back(std::sin(th) * d * d);
+    for (int side = 0; side < 2; ++side)
+        for (int i = 0; i < half; ++i) {
+            const double c = side == 0 ? x[std::size_t(i)] : -x[std::size_t(i)];
+            const double sn = std::sqrt(std::max(0.0, 1.0 - c * c));
+            for (int j = 0; j < 2 * n; ++j) {
+                const double ph = (double(j) + 0.5) * d;
+                s.dir.emplace_back(std::cos(ph) * sn, std::sin(ph) * sn, c);
+                s.weight.push_back(w[std::size_t(i)] * d);
+            }
         }
-    }
     return s;
 }
 
@@ -91,7 +101,7 @@ Taps taps(const Grid4Shape& g, int ground, Axis r, Axis m, Axis s_, Axis n_) {
                     t.index[q] = std::size_t(grid4_index(g.nmu, g.nmus, g.nnu, ir + a, ground, im + b, is + s, in + n));
                 }
     t.fs = fs;
-    t.below_horizon = grid4_mus_cell_below_horizon(g.R0, g.Rt, g.mu_s_min, g.nmus, is);
+    t.below_horizon = grid4_mus_cell_below_horizon(g.x_horizon, g.nmus, is);
     return t;
 }
 
@@ -180,6 +190,7 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
     g.R0 = atm.planet_radius_km;
     g.Rt = atm.top_radius_km;
     g.mu_s_min = res.mu_s_min;
+    g.x_horizon = grid4_mus_coordinate(g.R0, g.Rt, g.mu_s_min, 0.0);
 
     const TransmittanceTable T(atm);
     const std::size_t N = g.nodes();

@@ -20,7 +20,9 @@ namespace skybake::sky {
 struct Grid4Shape {
     int nr = 2, nmu = 2, nmus = 2, nnu = 2; // nmu per half
     double R0 = 6360.0, Rt = 6420.0, mu_s_min = -0.5;
-
+    // The sun axis' coordinate of the horizon (μs = 0, grid4_mus_coordinate),
+    // for grid4_mus_cell_below_horizon; ScatteringOrders::compute sets it.
+    double x_horizon = 0.0;
     std::size_t nodes() const { return std::size_t(nr) * 2u * std::size_t(nmu) * std::size_t(nmus) * std::size_t(nnu); }
     // The geometry of node `index` (grid4_index order). ν is clamped to the
     // values that μ and μs allow; ground: the ray meets the ground.

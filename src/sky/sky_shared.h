@@ -532,7 +532,7 @@ SKYBAKE_HD_INLINE vec3 orders_lookup(SB_IN(MultipleHD) m, float R0, float Rt, fl
                 }
         at[s] = sum;
     }
-    int below = grid4_mus_cell_below_horizon(R0, Rt, m.mu_s_min, m.nmus, is);
+    int below = grid4_mus_cell_below_horizon(grid4_mus_coordinate(R0, Rt, m.mu_s_min, 0.0f), m.nmus, is);
     return vec3(grid4_mus_blend(at[0].x, at[1].x, fs, below), grid4_mus_blend(at[0].y, at[1].y, fs, below),
                 grid4_mus_blend(at[0].z, at[1].z, fs, below));
 }
