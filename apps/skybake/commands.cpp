@@ -33,6 +33,7 @@ const Group kGroups[] = {
     {"prt", "Bake spherical-harmonic transfer (PRT/DPRT)"},
     {"fly", "Render frames of a flight from sea level to space (OpenGL, headless)"},
     {"view", "Interactive viewers (OpenGL window)"},
+    {"web", "Write a static web site of a baked model under the neural sky (WebGL 2)"},
 };
 
 } // namespace

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "skybake/mesh.h"
 
@@ -138,5 +139,9 @@ private:
     Mesh plain_;
     ImportReport report_;
 };
+
+// Standard base64 (RFC 4648, with padding) of `bytes`: tinygltf's encoder,
+// the one that writes data: URIs. For embedding a .glb in a web page.
+std::string base64_encode(std::string_view bytes);
 
 } // namespace skybake

@@ -33,6 +33,7 @@
 #include "skybake/error.h"
 #include "io/texture_path.h"
 #include "skybake/files.h"
+#include "skybake/gltf_asset.h"
 
 namespace skybake::io {
 
@@ -752,3 +753,12 @@ void write_glb(const std::filesystem::path& tmp, const Mesh& mesh) {
 }
 
 } // namespace skybake::io
+
+namespace skybake {
+
+std::string base64_encode(std::string_view bytes) {
+    return tinygltf::base64_encode(reinterpret_cast<const unsigned char*>(bytes.data()),
+                                   static_cast<unsigned int>(bytes.size()));
+}
+
+} // namespace skybake

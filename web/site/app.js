@@ -1,0 +1,235 @@
+// The page of `skybake web`: a baked model lit by the neural sky in WebGL 2.
+// `skybake web` writes data.js beside it, which sets window.SKYBAKE_SITE:
+//   { model: base64 .glb, weights: the weights JSON, skyGlsl: `sky export
+//     --format glsl-es`, prt: null | { glsl, attributes, order, channels } }
+// (scripts, not fetched files, so that the page opens from file:// too).
+// Everything else is bundled into one script by esbuild at build time.
+import {
+  ACESFilmicToneMapping,
+  Box3,
+  BufferAttribute,
+  Color,
+  DirectionalLight,
+  Mesh,
+  MeshStandardMaterial,
+  PlaneGeometry,
+  PCFSoftShadowMap,
+  PerspectiveCamera,
+  Scene,
+  SRGBColorSpace,
+  Vector3,
+  WebGLRenderer,
+} from 'three';
+import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import { NeuralSky, skybakeLighting } from '../src/three.js';
+
+const say = (text, isError = false) => {
+  const el = document.getElementById('message');
+  el.textContent = text;
+  el.className = isError ? 'error' : '';
+  (isError ? console.error : console.log)(`skybake: ${text}`);
+};
+
+function base64ToBuffer(b64) {
+  const bin = atob(b64);
+  const out = new Uint8Array(bin.length);
+  for (let i = 0; i < bin.length; ++i) out[i] = bin.charCodeAt(i);
+  return out.buffer;
+}
+
+function parseGlb(buffer) {
+  return new Promise((resolve, reject) => new GLTFLoader().parse(buffer, '', resolve, (e) => reject(new Error(`the model: ${e.message ?? e}`))));
+}
+
+// The sun's transmittance from the model's ground to space along elevation
+// e (degrees), from the weights file's atmosphere (its components' extinction
+// and density profiles), by the midpoint rule; zero below the horizon.
+function sunTransmittance(atm, elevationDeg) {
+  const R0 = atm.planet_radius_km, Rt = atm.top_radius_km;
+  const mu = Math.sin((elevationDeg * Math.PI) / 180);
+  if (mu < 0) return [0, 0, 0];
+  const length = -R0 * mu + Math.sqrt(R0 * R0 * (mu * mu - 1) + Rt * Rt);
+  const density = (c, h) => {
+    const p = c.profile ?? {};
+    if (p.type === 'exponential') return Math.exp(-h / p.scale_height_km);
+    if (p.type === 'tent') return Math.max(0, 1 - Math.abs(h - p.center_km) / p.half_width_km);
+    return 1;
+  };
+  const tau = [0, 0, 0], n = 256, dt = length / n;
+  for (let i = 0; i < n; ++i) {
+    const t = (i + 0.5) * dt;
+    const h = Math.sqrt(R0 * R0 + t * t + 2 * R0 * t * mu) - R0;
+    for (const c of atm.components) for (let k = 0; k < 3; ++k) tau[k] += c.extinction_per_km[k] * density(c, h) * dt;
+  }
+  return tau.map((x) => Math.exp(-x));
+}
+
+async function main() {
+  const data = window.SKYBAKE_SITE;
+  if (!data) throw new Error('data.js is missing or did not load (write the site again with `skybake web`)');
+  const canvas = document.getElementById('view');
+  if (!canvas.getContext('webgl2')) throw new Error('this browser has no WebGL 2');
+
+  const renderer = new WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+  renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+  renderer.toneMapping = ACESFilmicToneMapping;
+  renderer.outputColorSpace = SRGBColorSpace;
+  renderer.shadowMap.enabled = true;
+  renderer.shadowMap.type = PCFSoftShadowMap;
+  const scene = new Scene();
+  scene.background = new Color(0, 0, 0);
+
+  const sky = new NeuralSky(data.weights, data.skyGlsl, { order: data.prt ? data.prt.order : 3 });
+  sky.scale.setScalar(1e5);
+  scene.add(sky);
+
+  const gltf = await parseGlb(base64ToBuffer(data.model));
+  const model = gltf.scene;
+  const box = new Box3().setFromObject(model);
+  const size = box.getSize(new Vector3()).length() || 1;
+  const centre = box.getCenter(new Vector3());
+
+  // The sky's light through the bake: the transfer where the file has one,
+  // else its AO (_AO, else COLOR_0) times the unshadowed SH light.
+  const hooks = [];
+  let shading = 'flat';
+  model.traverse((o) => {
+    if (!o.isMesh) return;
+    o.castShadow = true;
+    o.receiveShadow = true;
+    const a = o.geometry.attributes;
+    const base = o.material && o.material.color ? o.material.color : new Color(0.8, 0.8, 0.8);
+    const material = new MeshStandardMaterial({ color: base.clone(), roughness: 1, metalness: 0, map: o.material?.map ?? null });
+    o.material = material;
+    if (data.prt && a._prt_0) {
+      hooks.push(skybakeLighting(material, { mode: 'prt', prtGlsl: data.prt.glsl, attributes: data.prt.attributes, order: data.prt.order, albedo: base.toArray() }));
+      shading = 'PRT';
+    } else if (a._ao || a.color) {
+      hooks.push(skybakeLighting(material, { mode: 'ao', aoAttribute: a._ao ? '_ao' : 'color', order: 3, albedo: base.toArray() }));
+      if (shading !== 'PRT') shading = 'AO';
+    }
+    material.vertexColors = false;
+  });
+  if (shading === 'flat') say('this model has no baked transfer (_PRT_i) and no AO (_AO or COLOR_0): shown with the sun only', true);
+  scene.add(model);
+
+  // The ground around the model, at the atmosphere's ground albedo, lit by
+  // the sun and by the sky (AO 1), so that the view below the horizon is land.
+  const groundAlbedo = data.weights.atmosphere?.ground_albedo ?? [0.1, 0.1, 0.1];
+  const groundGeometry = new PlaneGeometry(size * 200, size * 200).rotateX(-Math.PI / 2);
+  groundGeometry.setAttribute('_ao', new BufferAttribute(new Float32Array(groundGeometry.attributes.position.count).fill(1), 1));
+  const groundMaterial = new MeshStandardMaterial({ color: new Color(...groundAlbedo), roughness: 1, metalness: 0 });
+  hooks.push(skybakeLighting(groundMaterial, { mode: 'ao', aoAttribute: '_ao', order: 3, albedo: groundAlbedo }));
+  const ground = new Mesh(groundGeometry, groundMaterial);
+  ground.position.set(centre.x, box.min.y - 1e-3 * size, centre.z);
+  ground.receiveShadow = true;
+  scene.add(ground);
+
+  const sun = new DirectionalLight(0xffffff, 1);
+  sun.castShadow = true;
+  sun.shadow.mapSize.set(2048, 2048);
+  const r = size * 0.75;
+  Object.assign(sun.shadow.camera, { left: -r, right: r, top: r, bottom: -r, near: 0.01 * size, far: 4 * size });
+  sun.target.position.copy(centre);
+  scene.add(sun, sun.target);
+
+  const camera = new PerspectiveCamera(45, 1, size * 0.01, size * 100);
+  camera.position.copy(centre).add(new Vector3(0.8, 0.22, 1.0).multiplyScalar(size * 0.8));
+  const controls = new OrbitControls(camera, canvas);
+  controls.target.copy(centre);
+  controls.update();
+
+  // Controls.
+  const ui = (id) => document.getElementById(id);
+  const state = { elevation: 25, azimuth: 135, exposure: 0, auto: true, animate: false };
+  const params = new URLSearchParams(window.location.search);
+  for (const k of ['elevation', 'azimuth', 'exposure']) if (params.has(k)) state[k] = Number(params.get(k));
+  if (params.has('exposure')) state.auto = false;
+  ui('elevation').value = state.elevation;
+  ui('azimuth').value = state.azimuth;
+  ui('exposure').value = state.exposure;
+  ui('auto').checked = state.auto;
+  ui('elevation').oninput = (e) => (state.elevation = Number(e.target.value));
+  ui('azimuth').oninput = (e) => (state.azimuth = Number(e.target.value));
+  ui('exposure').oninput = (e) => ((state.exposure = Number(e.target.value)), (state.auto = false), (ui('auto').checked = false));
+  ui('auto').onchange = (e) => (state.auto = e.target.checked);
+  ui('animate').onchange = (e) => (state.animate = e.target.checked);
+  ui('screenshot').onclick = () => {
+    const a = document.createElement('a');
+    a.href = canvas.toDataURL('image/png');
+    a.download = 'skybake.png';
+    a.click();
+  };
+  ui('shading').textContent = shading;
+
+  const resize = () => {
+    const w = canvas.clientWidth, h = canvas.clientHeight;
+    if (canvas.width !== Math.floor(w * renderer.getPixelRatio()) || canvas.height !== Math.floor(h * renderer.getPixelRatio())) {
+      renderer.setSize(w, h, false);
+      camera.aspect = w / h;
+      camera.updateProjectionMatrix();
+    }
+  };
+
+  let last = performance.now();
+  let lightKey = '';
+  const frame = (now) => {
+    const dt = (now - last) / 1000;
+    last = now;
+    if (state.animate) {
+      state.elevation = ((state.elevation + 100 + dt * 4) % 200) - 100; // −100° to 100°, a day in 50 s
+      ui('elevation').value = Math.max(-20, Math.min(90, state.elevation));
+    }
+    const elevation = Math.max(-20, Math.min(90, state.elevation));
+    sky.setSun(elevation, state.azimuth);
+    const s = sky.material.uniforms.sunPosition.value;
+    sun.position.copy(centre).addScaledVector(s, 2 * size);
+    const key = `${elevation.toFixed(2)} ${state.azimuth.toFixed(2)}`;
+    if (key !== lightKey) {
+      lightKey = key;
+      const light = sky.shLight();
+      for (const h of hooks) h.update(light);
+      // three's Lambert is albedo/π × the light's irradiance, as the bake's
+      // radiance is: the sun gives irradiance T per unit sun irradiance.
+      const T = sunTransmittance(data.weights.atmosphere, elevation);
+      sun.color.setRGB(T[0], T[1], T[2]);
+      sun.intensity = 1;
+      const up = Math.max(0, Math.sin((elevation * Math.PI) / 180)) * (0.2126 * T[0] + 0.7152 * T[1] + 0.0722 * T[2]);
+      // Automatic exposure: the sky's mean radiance (L00 / 2√π) to mid-grey.
+      const L00 = light.coefficients[0];
+      // A white surface facing up sees πL̄ from the sky and `up` from the sun.
+      const mean = (0.2126 * L00[0] + 0.7152 * L00[1] + 0.0722 * L00[2]) / (2 * Math.sqrt(Math.PI)) + up / Math.PI;
+      state.autoExposure = mean > 0 ? Math.log2(0.18 / mean) : 0;
+    }
+    const ev = state.auto ? state.autoExposure : state.exposure;
+    renderer.toneMappingExposure = Math.pow(2, ev);
+    ui('ev').textContent = `${ev >= 0 ? '+' : ''}${ev.toFixed(2)} EV`;
+    resize();
+    controls.update();
+    renderer.render(scene, camera);
+    window.skybakeSiteFrames = (window.skybakeSiteFrames ?? 0) + 1;
+    requestAnimationFrame(frame);
+  };
+  requestAnimationFrame(frame);
+  // For tests and scripts: the mean RGB (0–255) of a rectangle of the view,
+  // in fractions of its size from the top left, drawn and read at once.
+  const regionMean = (x0, y0, x1, y1) => {
+    renderer.render(scene, camera);
+    const gl = renderer.getContext();
+    const W = gl.drawingBufferWidth, H = gl.drawingBufferHeight;
+    const X = Math.floor(x0 * W), w = Math.max(1, Math.floor((x1 - x0) * W)), h = Math.max(1, Math.floor((y1 - y0) * H));
+    const Y = H - Math.floor(y0 * H) - h;
+    const px = new Uint8Array(w * h * 4);
+    gl.readPixels(X, Y, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    const m = [0, 0, 0];
+    for (let i = 0; i < px.length; i += 4) for (let k = 0; k < 3; ++k) m[k] += px[i + k];
+    return m.map((v) => v / (w * h));
+  };
+  window.skybakeSite = { shading, regionMean };
+}
+
+main().catch((e) => {
+  say(e.message ?? String(e), true);
+  window.skybakeSite = { error: e.message ?? String(e) };
+});

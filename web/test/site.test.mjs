@@ -1,0 +1,103 @@
+// `skybake web` end to end, in headless Chromium (WebGL 2 on SwiftShader):
+// sites of a PRT bake and of an AO bake open from file:// with no console
+// error and draw a lit model under a sky; bad inputs fail in the CLI with
+// one line; a page without its data, or a browser without WebGL 2, says so
+// on the page. Needs SKYBAKE_CLI, SKYBAKE_TEST_DATA and SKYBAKE_CHROMIUM.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawnSync } from 'node:child_process';
+import { existsSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { pathToFileURL } from 'node:url';
+
+const chromium = process.env.SKYBAKE_CHROMIUM ?? '/usr/bin/chromium';
+const cli = process.env.SKYBAKE_CLI;
+const weights = join(process.env.SKYBAKE_TEST_DATA, 'neural', 'v3_earth_default.json');
+const puppeteer = (await import('puppeteer-core')).default;
+const dir = mkdtempSync(join(tmpdir(), 'skybake-site-'));
+
+function skybake(...args) {
+  const r = spawnSync(cli, args, { encoding: 'utf8' });
+  return { code: r.status, out: r.stdout, err: r.stderr };
+}
+
+async function open(url, extraArgs = []) {
+  const browser = await puppeteer.launch({
+    executablePath: chromium,
+    headless: true,
+    args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist', '--window-size=640,400', ...extraArgs],
+  });
+  const page = await browser.newPage();
+  await page.setViewport({ width: 640, height: 400 });
+  const errors = [];
+  page.on('console', (m) => m.type() === 'error' && errors.push(m.text()));
+  page.on('pageerror', (e) => errors.push(String(e)));
+  await page.goto(url);
+  return { browser, page, errors };
+}
+
+// Mean RGB (0–255) of the view over a rectangle in fractions of its size.
+const regionMean = (page, ...r) => page.evaluate((r) => window.skybakeSite.regionMean(...r), r);
+
+test('skybake web: PRT and AO sites, and their errors', async () => {
+  const city = join(dir, 'city.glb');
+  assert.equal(skybake('mesh', 'generate', '--kind', 'city', '--triangles', '3000', '--seed', '2', '-o', city).code, 0);
+  assert.equal(skybake('prt', 'bake', city, '--order', '3', '--rule', 'lebedev:194', '-o', join(dir, 'city_prt.glb')).code, 0);
+  assert.equal(skybake('ao', city, '--rule', 'lebedev:194', '-o', join(dir, 'city_ao.glb')).code, 0);
+
+  for (const [name, shading] of [['city_prt', 'PRT'], ['city_ao', 'AO']]) {
+    const site = join(dir, `site_${name}`);
+    const r = skybake('web', join(dir, `${name}.glb`), '--model', weights, '-o', site);
+    assert.equal(r.code, 0, r.err);
+    assert.match(r.out + r.err, new RegExp(`${shading} shading`));
+    for (const f of ['index.html', 'skybake-site.js', 'data.js']) assert.ok(existsSync(join(site, f)), f);
+    const { browser, page, errors } = await open(`${pathToFileURL(join(site, 'index.html')).href}?elevation=20&azimuth=135`);
+    try {
+      await page.waitForFunction('(window.skybakeSiteFrames ?? 0) >= 3 || window.skybakeSite?.error', { timeout: 120000 });
+      const s = await page.evaluate('({ error: window.skybakeSite.error, shading: window.skybakeSite.shading })');
+      assert.equal(s.error, undefined, s.error);
+      assert.equal(s.shading, shading);
+      assert.deepEqual(errors, []);
+      const sky = await regionMean(page, 0.0, 0.0, 1.0, 0.08);
+      const model = await regionMean(page, 0.4, 0.45, 0.6, 0.65);
+      console.log(`${name}: sky ${sky.map((v) => v.toFixed(0))}, model ${model.map((v) => v.toFixed(0))}`);
+      // A daytime sky: bright and blue; the model lit, and not the sky.
+      assert.ok(sky[2] > 40 && sky[2] > 1.2 * sky[0], `sky ${sky}`);
+      assert.ok(Math.max(...model) > 25, `model ${model}`);
+      assert.ok(Math.abs(model[2] - sky[2]) > 5 || Math.abs(model[0] - sky[0]) > 5, 'the model is not drawn');
+    } finally {
+      await browser.close();
+    }
+  }
+
+  // Bad inputs: one line on stderr, a non-zero exit, no site.
+  const corrupt = join(dir, 'corrupt.json');
+  writeFileSync(corrupt, '{"format": "skybake-neural-sky", "weights": [');
+  for (const [args, code] of [
+    [[join(dir, 'city_prt.glb'), '--model', corrupt, '-o', join(dir, 'bad1')], 1],
+    [[join(dir, 'city.ply'), '--model', weights, '-o', join(dir, 'bad2')], 2],
+    [[join(dir, 'missing.glb'), '--model', weights, '-o', join(dir, 'bad3')], 1],
+  ]) {
+    const r = skybake('web', ...args);
+    assert.equal(r.code, code, r.err);
+    assert.equal(r.err.trim().split('\n').length, 1, r.err);
+    assert.ok(!existsSync(args[4]), `${args[4]} was left behind`);
+  }
+
+  // A page whose data.js is gone, and a browser without WebGL 2: a message, not a blank page.
+  const site = join(dir, 'site_city_ao');
+  rmSync(join(site, 'data.js'));
+  for (const [extra, want] of [[[], /data\.js/], [['--disable-3d-apis'], /WebGL 2/]]) {
+    if (extra.length) skybake('web', join(dir, 'city_ao.glb'), '--model', weights, '-o', site);
+    const { browser, page, errors } = await open(pathToFileURL(join(site, 'index.html')).href, extra);
+    try {
+      await page.waitForFunction('window.skybakeSite?.error', { timeout: 60000 });
+      const text = await page.evaluate(() => document.getElementById('message').textContent);
+      assert.match(text, want);
+      assert.ok(errors.some((e) => want.test(e)), `the console says it too: ${errors}`);
+    } finally {
+      await browser.close();
+    }
+  }
+});
