@@ -6,7 +6,12 @@
 // model (.glb, base64), the weights file, the network's GLSL ES export and,
 // for a model from `prt bake`, the transfer's GLSL ES export and layout.
 // data.js is a script, not files to fetch, because browsers refuse fetch()
-// on file://.
+// on file://. --serve then serves the folder on 127.0.0.1 with Python's
+// http.server (in the foreground; Ctrl-C stops it).
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <fstream>
 
 #include <nlohmann/json.hpp>
@@ -47,11 +52,15 @@ fs::path site_dir() {
 void add_web(CLI::App& app) {
     struct Opts {
         std::string model, weights, output;
+        bool serve = false;
+        int port = 8000;
     };
     auto o = std::make_shared<Opts>();
     app.add_option("model", o->model, "A .glb: from `prt bake` (PRT shading), `ao` (AO shading) or any other")->required();
     app.add_option("--model", o->weights, "Weights file of the neural sky (JSON from `skybake sky train`)")->required();
     app.add_option("-o,--output", o->output, "Folder of the site (created; files in it are replaced)")->required();
+    app.add_flag("--serve", o->serve, "Then serve the folder on http://127.0.0.1:PORT/ until interrupted (python3's http.server)");
+    app.add_option("--port", o->port, "Port of --serve")->check(CLI::Range(1, 65535))->capture_default_str();
     app.callback([o] {
         if (fs::path(o->model).extension() != ".glb")
             throw UsageError(fmt::format("'{}' is not a .glb (`skybake mesh convert` writes one)", o->model), "model");
@@ -85,6 +94,15 @@ void add_web(CLI::App& app) {
         folder.keep();
         info("{} ({} shading, {} KiB) under {} ({} weights) -> {}", o->model, prt.is_null() ? "AO" : "PRT",
              glb.size() / 1024, net.atmosphere.name, net.topology.weight_count(), (out / "index.html").string());
+        if (!o->serve)
+            return;
+        const std::string port = std::to_string(o->port), folder_arg = out.string();
+        fmt::print("serving {} at http://127.0.0.1:{}/ (Ctrl-C stops)\n", folder_arg, port);
+        std::fflush(stdout);
+        const char* argv[] = {"python3", "-m", "http.server", port.c_str(), "--bind", "127.0.0.1", "--directory",
+                              folder_arg.c_str(), nullptr};
+        execvp("python3", const_cast<char* const*>(argv));
+        throw Error(fmt::format("cannot run python3 to serve the site: {}", std::strerror(errno)), "--serve");
     });
 }
 

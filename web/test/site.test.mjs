@@ -1,11 +1,12 @@
 // `skybake web` end to end, in headless Chromium (WebGL 2 on SwiftShader):
-// sites of a PRT bake and of an AO bake open from file:// with no console
-// error and draw a lit model under a sky; bad inputs fail in the CLI with
+// sites of a PRT bake and of an AO bake open from file:// (and the first from
+// --serve) with no console error and draw a lit model under a sky; bad inputs fail in the CLI with
 // one line; a page without its data, or a browser without WebGL 2, says so
 // on the page. Needs SKYBAKE_CLI, SKYBAKE_TEST_DATA and SKYBAKE_CHROMIUM.
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
-import { spawnSync } from 'node:child_process';
+import { spawn, spawnSync } from 'node:child_process';
+import { createServer } from 'node:net';
 import { existsSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
@@ -46,13 +47,36 @@ test('skybake web: PRT and AO sites, and their errors', async () => {
   assert.equal(skybake('prt', 'bake', city, '--order', '3', '--rule', 'lebedev:194', '-o', join(dir, 'city_prt.glb')).code, 0);
   assert.equal(skybake('ao', city, '--rule', 'lebedev:194', '-o', join(dir, 'city_ao.glb')).code, 0);
 
-  for (const [name, shading] of [['city_prt', 'PRT'], ['city_ao', 'AO']]) {
-    const site = join(dir, `site_${name}`);
-    const r = skybake('web', join(dir, `${name}.glb`), '--model', weights, '-o', site);
-    assert.equal(r.code, 0, r.err);
-    assert.match(r.out + r.err, new RegExp(`${shading} shading`));
+  const port = await new Promise((resolve) => {
+    const server = createServer().listen(0, '127.0.0.1', () => {
+      const p = server.address().port;
+      server.close(() => resolve(p));
+    });
+  });
+  for (const [name, shading, serve] of [['city_prt', 'PRT', false], ['city_ao', 'AO', false], ['city_prt', 'PRT', true]]) {
+    const site = join(dir, `site_${name}${serve ? '_served' : ''}`);
+    let url = `${pathToFileURL(join(site, 'index.html')).href}?elevation=20&azimuth=135`;
+    let server = null;
+    if (serve) {
+      server = spawn(cli, ['web', join(dir, `${name}.glb`), '--model', weights, '-o', site, '--serve', '--port', String(port)]);
+      let out = '';
+      server.stdout.on('data', (d) => (out += d));
+      for (let i = 0; i < 200 && !/serving .* at http:\/\/127\.0\.0\.1:\d+\//.test(out); ++i) await new Promise((r) => setTimeout(r, 100));
+      assert.match(out, /serving .* at http:\/\/127\.0\.0\.1:\d+\//);
+      url = `http://127.0.0.1:${port}/index.html?elevation=20&azimuth=135`;
+      for (let i = 0; i < 100; ++i) {
+        try {
+          if ((await fetch(url)).ok) break;
+        } catch {}
+        await new Promise((r) => setTimeout(r, 100));
+      }
+    } else {
+      const r = skybake('web', join(dir, `${name}.glb`), '--model', weights, '-o', site);
+      assert.equal(r.code, 0, r.err);
+      assert.match(r.out + r.err, new RegExp(`${shading} shading`));
+    }
     for (const f of ['index.html', 'skybake-site.js', 'data.js']) assert.ok(existsSync(join(site, f)), f);
-    const { browser, page, errors } = await open(`${pathToFileURL(join(site, 'index.html')).href}?elevation=20&azimuth=135`);
+    const { browser, page, errors } = await open(url);
     try {
       await page.waitForFunction('(window.skybakeSiteFrames ?? 0) >= 3 || window.skybakeSite?.error', { timeout: 120000 });
       const s = await page.evaluate('({ error: window.skybakeSite.error, shading: window.skybakeSite.shading })');
@@ -61,13 +85,14 @@ test('skybake web: PRT and AO sites, and their errors', async () => {
       assert.deepEqual(errors, []);
       const sky = await regionMean(page, 0.0, 0.0, 1.0, 0.08);
       const model = await regionMean(page, 0.4, 0.45, 0.6, 0.65);
-      console.log(`${name}: sky ${sky.map((v) => v.toFixed(0))}, model ${model.map((v) => v.toFixed(0))}`);
+      console.log(`${name}${serve ? ' (served)' : ''}: sky ${sky.map((v) => v.toFixed(0))}, model ${model.map((v) => v.toFixed(0))}`);
       // A daytime sky: bright and blue; the model lit, and not the sky.
       assert.ok(sky[2] > 40 && sky[2] > 1.2 * sky[0], `sky ${sky}`);
       assert.ok(Math.max(...model) > 25, `model ${model}`);
       assert.ok(Math.abs(model[2] - sky[2]) > 5 || Math.abs(model[0] - sky[0]) > 5, 'the model is not drawn');
     } finally {
       await browser.close();
+      if (server) server.kill();
     }
   }
 
