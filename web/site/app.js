@@ -90,28 +90,39 @@ async function main() {
   const size = box.getSize(new Vector3()).length() || 1;
   const centre = box.getCenter(new Vector3());
 
-  // The sky's light through the bake: the transfer where the file has one,
-  // else its AO (_AO, else COLOR_0) times the unshadowed SH light.
+  // The sky's light through the bake: the transfer where the file has one
+  // ('PRT'), its AO (_AO, else COLOR_0) times the unshadowed SH light ('AO'),
+  // or none ('sun': the sun alone). Each mesh gets a material per mode the
+  // file allows; the panel switches between them.
   const hooks = [];
-  let shading = 'flat';
+  const modes = new Set(['sun']);
+  const meshes = [];
   model.traverse((o) => {
     if (!o.isMesh) return;
     o.castShadow = true;
     o.receiveShadow = true;
     const a = o.geometry.attributes;
     const base = o.material && o.material.color ? o.material.color : new Color(0.8, 0.8, 0.8);
-    const material = new MeshStandardMaterial({ color: base.clone(), roughness: 1, metalness: 0, map: o.material?.map ?? null });
-    o.material = material;
+    const make = () => new MeshStandardMaterial({ color: base.clone(), roughness: 1, metalness: 0, map: o.material?.map ?? null });
+    const materials = { sun: make() };
     if (data.prt && a._prt_0) {
-      hooks.push(skybakeLighting(material, { mode: 'prt', prtGlsl: data.prt.glsl, attributes: data.prt.attributes, order: data.prt.order, albedo: base.toArray() }));
-      shading = 'PRT';
-    } else if (a._ao || a.color) {
-      hooks.push(skybakeLighting(material, { mode: 'ao', aoAttribute: a._ao ? '_ao' : 'color', order: 3, albedo: base.toArray() }));
-      if (shading !== 'PRT') shading = 'AO';
+      materials.PRT = make();
+      hooks.push(skybakeLighting(materials.PRT, { mode: 'prt', prtGlsl: data.prt.glsl, attributes: data.prt.attributes, order: data.prt.order, albedo: base.toArray() }));
+      modes.add('PRT');
     }
-    material.vertexColors = false;
+    if (a._ao || a.color) {
+      materials.AO = make();
+      hooks.push(skybakeLighting(materials.AO, { mode: 'ao', aoAttribute: a._ao ? '_ao' : 'color', order: 3, albedo: base.toArray() }));
+      modes.add('AO');
+    }
+    meshes.push({ mesh: o, materials });
   });
-  if (shading === 'flat') say('this model has no baked transfer (_PRT_i) and no AO (_AO or COLOR_0): shown with the sun only', true);
+  const shading = modes.has('PRT') ? 'PRT' : modes.has('AO') ? 'AO' : 'sun';
+  const setShading = (mode) => {
+    for (const { mesh, materials } of meshes) mesh.material = materials[mode] ?? materials.sun;
+  };
+  setShading(shading);
+  if (shading === 'sun') say('this model has no baked transfer (_PRT_i) and no AO (_AO or COLOR_0): shown with the sun only', true);
   scene.add(model);
 
   // The ground around the model, at the atmosphere's ground albedo, lit by
@@ -161,7 +172,26 @@ async function main() {
     a.download = 'skybake.png';
     a.click();
   };
-  ui('shading').textContent = shading;
+  for (const mode of ['PRT', 'AO', 'sun'].filter((m) => modes.has(m))) ui('shading').add(new Option(mode, mode, mode === shading, mode === shading));
+  ui('shading').onchange = (e) => setShading(e.target.value);
+  // Shift-drag on the view moves the sun (the orbit camera takes plain drags).
+  let drag = null;
+  canvas.addEventListener('pointerdown', (e) => {
+    if (!e.shiftKey) return;
+    controls.enabled = false;
+    drag = { x: e.clientX, y: e.clientY, elevation: state.elevation, azimuth: state.azimuth };
+  });
+  window.addEventListener('pointermove', (e) => {
+    if (!drag) return;
+    state.azimuth = (((drag.azimuth + (e.clientX - drag.x) * 0.5) % 360) + 360) % 360;
+    state.elevation = Math.max(-20, Math.min(90, drag.elevation - (e.clientY - drag.y) * 0.25));
+    ui('elevation').value = state.elevation;
+    ui('azimuth').value = state.azimuth;
+  });
+  window.addEventListener('pointerup', () => {
+    drag = null;
+    controls.enabled = true;
+  });
 
   const resize = () => {
     const w = canvas.clientWidth, h = canvas.clientHeight;

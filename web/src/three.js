@@ -143,7 +143,10 @@ export function skybakeLighting(material, { mode = 'prt', prtGlsl, attributes = 
       decl += prtGlsl;
     } else {
       const ao = aoAttribute === 'color' ? 'color.r' : aoAttribute;
-      if (aoAttribute !== 'color') decl += `attribute float ${aoAttribute};\n`;
+      // COLOR_0 without vertexColors: three declares no `color`, so declare it
+      // here (with vertexColors three would also multiply the sun's light by it).
+      if (aoAttribute === 'color') decl += '#if !defined(USE_COLOR) && !defined(USE_COLOR_ALPHA)\nattribute vec3 color;\n#endif\n';
+      else decl += `attribute float ${aoAttribute};\n`;
       // Irradiance of an order-2 SH light on the normal (Ramamoorthi & Hanrahan's
       // clamped-cosine factors π, 2π/3, π/4), radiance = albedo/π × E × AO.
       body = `{ vec3 n = normalize(mat3(modelMatrix) * objectNormal);

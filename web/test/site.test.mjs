@@ -90,6 +90,23 @@ test('skybake web: PRT and AO sites, and their errors', async () => {
       assert.ok(sky[2] > 40 && sky[2] > 1.2 * sky[0], `sky ${sky}`);
       assert.ok(Math.max(...model) > 25, `model ${model}`);
       assert.ok(Math.abs(model[2] - sky[2]) > 5 || Math.abs(model[0] - sky[0]) > 5, 'the model is not drawn');
+      if (name === 'city_prt' && !serve) {
+        // The panel: AO shading of the same bake (its COLOR_0) differs from
+        // PRT's and is lit too; a shift-drag moves the sun down.
+        await page.select('#shading', 'AO');
+        const ao = await regionMean(page, 0.4, 0.45, 0.6, 0.65);
+        console.log(`city_prt as AO: model ${ao.map((v) => v.toFixed(0))}`);
+        assert.ok(Math.max(...ao) > 25 && Math.abs(ao[0] - model[0]) + Math.abs(ao[2] - model[2]) > 0.5, `AO ${ao} against PRT ${model}`);
+        await page.keyboard.down('Shift');
+        await page.mouse.move(320, 300);
+        await page.mouse.down();
+        await page.mouse.move(360, 340, { steps: 4 });
+        await page.mouse.up();
+        await page.keyboard.up('Shift');
+        const elevation = await page.evaluate(() => Number(document.getElementById('elevation').value));
+        assert.ok(elevation < 15, `the sun is at ${elevation}° after the drag`);
+        assert.deepEqual(errors, []);
+      }
     } finally {
       await browser.close();
       if (server) server.kill();
