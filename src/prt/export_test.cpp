@@ -62,23 +62,22 @@ TEST(PrtExport, GlslCompiles) {
                                  "             skybake_prt_glossy(vec3(0.0, 1.0, 0.0), normalize(pos), "
                                  "vec3(0.0, 0.6, 0.8), 1.0);\n"
                                  "    gl_Position = vec4(pos, 1.0);\n}\n";
-        const std::string frag = "#version 300 es\nprecision highp float;\n" + fn +
-                                 "uniform vec3 light[16];\nuniform vec4 t[" + std::to_string(m) +
-                                 "];\nin vec3 nrm;\nout vec4 frag;\n"
-                                 "void main() { frag = vec4(skybake_prt_diffuse(t, light, vec3(0.5)) + "
-                                 "skybake_prt_glossy(normalize(nrm), vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), "
-                                 "0.5), 1.0); }\n";
+        // A fragment shader calling both functions, under a default precision.
+        const auto fragment = [m](const char* precision, const std::string& functions) {
+            return std::string("#version 300 es\nprecision ") + precision + " float;\n" + functions +
+                   "uniform vec3 light[16];\nuniform vec4 t[" + std::to_string(m) +
+                   "];\nin vec3 nrm;\nout vec4 frag;\n"
+                   "void main() { frag = vec4(skybake_prt_diffuse(t, light, vec3(0.5)) + "
+                   "skybake_prt_glossy(normalize(nrm), vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), "
+                   "0.5), 1.0); }\n";
+        };
+        const std::string frag = fragment("highp", fn);
         // GLSL ES 3.00 (WebGL 2) under a mediump default.
         o.es = true;
         const std::string es = export_prt_glsl(3, channels, o);
         o.es = false;
         EXPECT_NE(es.find("highp vec3 skybake_prt_diffuse("), std::string::npos);
-        const std::string frag_es = "#version 300 es\nprecision mediump float;\n" + es +
-                                    "uniform vec3 light[16];\nuniform vec4 t[" + std::to_string(m) +
-                                    "];\nin vec3 nrm;\nout vec4 frag;\n"
-                                    "void main() { frag = vec4(skybake_prt_diffuse(t, light, vec3(0.5)) + "
-                                    "skybake_prt_glossy(normalize(nrm), vec3(0.0, 0.0, 1.0), vec3(0.0, 1.0, 0.0), "
-                                    "0.5), 1.0); }\n";
+        const std::string frag_es = fragment("mediump", es);
         for (const auto& [name, text] :
              {std::pair{"prt.vert", vert}, std::pair{"prt.frag", frag}, std::pair{"prt_es.frag", frag_es}}) {
             std::ofstream(dir / name) << text;

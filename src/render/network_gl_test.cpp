@@ -148,15 +148,21 @@ TEST(GlNetwork, WiderSharedTopologyMatchesToo) {
     std::printf("GLSL network (shared:16x16) vs mlp_hd.h: max relative error %.3g over %d inputs\n", err, compared);
 }
 
+// A random shared:12x8 network with the given encodings and moderate
+// weights: the tests compare arithmetic, not saturated sigmoids.
+NeuralSky encoded_network(InputEncoding inputs, OutputEncoding outputs) {
+    NeuralSky net = neural_test::with_encoding(neural_test::random_network("shared:12x8", 7), inputs, outputs, 8);
+    for (float& w : net.weights)
+        w *= 0.5f;
+    return net;
+}
+
 // `sky export --format glsl-es` (WebGL 2) in an OpenGL ES 3.0 context, every
 // encoding: the same arithmetic as the library.
 TEST(GlNetwork, GlslEsMatchesTheCppForwardPassInAnEsContext) {
     for (InputEncoding inputs : {InputEncoding::Seed, InputEncoding::Horizon})
         for (OutputEncoding outputs : {OutputEncoding::Radiance, OutputEncoding::PhaseFactored}) {
-            NeuralSky net = neural_test::with_encoding(neural_test::random_network("shared:12x8", 7), inputs,
-                                                       outputs, 8);
-            for (float& w : net.weights)
-                w *= 0.5f;
+            const NeuralSky net = encoded_network(inputs, outputs);
             int compared = 0;
             const double err = glsl_network_error(net, &compared, ExportLanguage::GlslEs);
             SCOPED_TRACE(std::string(input_encoding_name(inputs)) + " / " + output_encoding_name(outputs));
@@ -178,10 +184,7 @@ TEST(GlNetwork, GlslEsMatchesTheCppForwardPassInAnEsContext) {
 TEST(GlNetwork, EveryEncodingMatchesTheCppForwardPass) {
     for (InputEncoding inputs : {InputEncoding::Seed, InputEncoding::Horizon})
         for (OutputEncoding outputs : {OutputEncoding::Radiance, OutputEncoding::PhaseFactored}) {
-            NeuralSky net = neural_test::with_encoding(neural_test::random_network("shared:12x8", 7), inputs,
-                                                       outputs, 8);
-            for (float& w : net.weights)
-                w *= 0.5f; // moderate codes: the test compares arithmetic, not saturated sigmoids
+            const NeuralSky net = encoded_network(inputs, outputs);
             int compared = 0;
             const double err = glsl_network_error(net, &compared);
             SCOPED_TRACE(std::string(input_encoding_name(inputs)) + " / " + output_encoding_name(outputs));
