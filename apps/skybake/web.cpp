@@ -21,6 +21,7 @@
 #include "flags.h"
 #include "skybake/files.h"
 #include "skybake/gltf_asset.h"
+#include "skybake/mesh.h"
 #include "skybake/neural.h"
 #include "skybake/prt.h"
 
@@ -68,8 +69,16 @@ void add_web(CLI::App& app) {
         const NeuralSky net = load_neural_sky(o->weights);
         const std::string sky_glsl = export_neural_sky(net, ExportLanguage::GlslEs);
         const std::string glb = read_file(o->model);
+        // The model is read once here, so that a corrupt or empty file fails
+        // now with its reason rather than later on the page.
         nlohmann::json prt = nullptr;
-        if (fs::exists(prt_sidecar_path(o->model))) {
+        std::string shading = "sun only";
+        if (!fs::exists(prt_sidecar_path(o->model))) {
+            const Mesh mesh = load_mesh(o->model);
+            if (mesh.find_attribute("ao") || !mesh.colors.empty())
+                shading = "AO";
+        } else {
+            shading = "PRT";
             const PrtModel m = load_prt(o->model);
             PrtShaderOptions so;
             so.es = true;
@@ -92,7 +101,7 @@ void add_web(CLI::App& app) {
             write_stream_atomic(out / name, [&](std::ostream& f) { f << text; });
         }
         folder.keep();
-        info("{} ({} shading, {} KiB) under {} ({} weights) -> {}", o->model, prt.is_null() ? "AO" : "PRT",
+        info("{} ({} shading, {} KiB) under {} ({} weights) -> {}", o->model, shading,
              glb.size() / 1024, net.atmosphere.name, net.topology.weight_count(), (out / "index.html").string());
         if (!o->serve)
             return;

@@ -116,10 +116,12 @@ test('skybake web: PRT and AO sites, and their errors', async () => {
   // Bad inputs: one line on stderr, a non-zero exit, no site.
   const corrupt = join(dir, 'corrupt.json');
   writeFileSync(corrupt, '{"format": "skybake-neural-sky", "weights": [');
+  writeFileSync(join(dir, 'garbage.glb'), 'glTF, or not at all');
   for (const [args, code] of [
     [[join(dir, 'city_prt.glb'), '--model', corrupt, '-o', join(dir, 'bad1')], 1],
     [[join(dir, 'city.ply'), '--model', weights, '-o', join(dir, 'bad2')], 2],
     [[join(dir, 'missing.glb'), '--model', weights, '-o', join(dir, 'bad3')], 1],
+    [[join(dir, 'garbage.glb'), '--model', weights, '-o', join(dir, 'bad4')], 1],
   ]) {
     const r = skybake('web', ...args);
     assert.equal(r.code, code, r.err);
