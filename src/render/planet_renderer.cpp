@@ -290,6 +290,7 @@ void PlanetScene::set_uniforms(GLuint p, const PlanetView& v, const Basis& b) co
     const sky::MultipleHD& m = a.ms;
     u1i("atm.ms.method", m.method);
     u1f("atm.ms.mu_s_min", m.mu_s_min);
+    u1f("atm.ms.x_horizon", m.x_horizon);
     u1i("atm.ms.orders", 0);
     u1i("atm.ms.nr", m.nr);
     u1i("atm.ms.nmu", m.nmu);

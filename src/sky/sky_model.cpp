@@ -56,6 +56,7 @@ void SkyModel::Impl::build_multiple() {
     const bool orders_method = atmosphere.multiple_method == MultipleScatteringMethod::Orders;
     sky::MultipleHD& m = hd.ms;
     m.mu_s_min = float(res.mu_s_min);
+    m.x_horizon = float(sky::grid4_mus_coordinate(atmosphere.planet_radius_km, atmosphere.top_radius_km, res.mu_s_min, 0.0));
     const auto point_at_main = [&](std::vector<float>& table) {
         if (orders_method) {
             orders = std::move(table);

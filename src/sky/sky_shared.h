@@ -75,6 +75,9 @@ struct ComponentHD {
 struct MultipleHD {
     int method SB_INIT(kMultipleNone);
     float mu_s_min SB_INIT(-0.5f); // the orders grid's lowest sun cosine; below it, values are those at mu_s_min
+    // grid4_mus_coordinate of μs = 0 for this grid (set with mu_s_min): its
+    // cells below it blend geometrically (grid4_mus_cell_below_horizon).
+    float x_horizon SB_INIT(0.0f);
     // Orders ≥ 2 of scattered radiance (1/sr per unit sun irradiance) over the
     // grid nr × (2 nmu) × nmus × nnu (see grid4_index).
     SB_DATA orders SB_INIT(0);
@@ -532,7 +535,7 @@ SKYBAKE_HD_INLINE vec3 orders_lookup(SB_IN(MultipleHD) m, float R0, float Rt, fl
                 }
         at[s] = sum;
     }
-    int below = grid4_mus_cell_below_horizon(grid4_mus_coordinate(R0, Rt, m.mu_s_min, 0.0f), m.nmus, is);
+    int below = grid4_mus_cell_below_horizon(m.x_horizon, m.nmus, is);
     return vec3(grid4_mus_blend(at[0].x, at[1].x, fs, below), grid4_mus_blend(at[0].y, at[1].y, fs, below),
                 grid4_mus_blend(at[0].z, at[1].z, fs, below));
 }
