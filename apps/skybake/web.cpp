@@ -88,12 +88,12 @@ void add_web(CLI::App& app) {
                    {"channels", m.transfer.channels},
                    {"attributes", (m.transfer.channels * count + 3) / 4}};
         }
-        const nlohmann::json weights = nlohmann::json::parse(read_file(o->weights));
+        const std::string weights = read_file(o->weights); // JSON, checked by load_neural_sky above
         OutputFolder folder(o->output, "--output");
         const fs::path out(o->output);
         write_stream_atomic(out / "data.js", [&](std::ostream& f) {
             f << "// Written by `skybake web`: the model, the neural sky and their shaders.\nwindow.SKYBAKE_SITE = {\n"
-              << "model: \"" << base64_encode(glb) << "\",\nweights: " << weights.dump() << ",\nskyGlsl: "
+              << "model: \"" << base64_encode(glb) << "\",\nweights: " << weights << ",\nskyGlsl: "
               << nlohmann::json(sky_glsl).dump() << ",\nprt: " << prt.dump() << "\n};\n";
         });
         for (const char* name : {"index.html", "skybake-site.js"}) {
