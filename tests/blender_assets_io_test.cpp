@@ -37,28 +37,9 @@ using Json = nlohmann::json;
 
 namespace {
 
-// Suzanne with Smart UV Project, exported as the argument after "--" names it
-// (.glb or .gltf); "material" gives her a plain Principled BSDF (a material
-// without textures), "bare" none.
-constexpr const char* kBlenderScript = R"(
-import sys, bpy
-out, kind = sys.argv[sys.argv.index("--") + 1:][:2]
-bpy.ops.wm.read_factory_settings(use_empty=True)
-bpy.ops.mesh.primitive_monkey_add()
-obj = bpy.context.active_object
-bpy.ops.object.shade_smooth()
-bpy.ops.object.mode_set(mode="EDIT")
-bpy.ops.mesh.select_all(action="SELECT")
-bpy.ops.uv.smart_project()
-bpy.ops.object.mode_set(mode="OBJECT")
-if kind == "material":
-    mat = bpy.data.materials.new("Clay")
-    mat.use_nodes = True
-    mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (0.8, 0.3, 0.2, 1.0)
-    obj.data.materials.append(mat)
-fmt = "GLB" if out.endswith(".glb") else "GLTF_SEPARATE"
-bpy.ops.export_scene.gltf(filepath=out, export_format=fmt)
-)";
+// Suzanne with Smart UV Project (tests/data/blender/make_suzanne.py, which
+// the web package's glTF validator test runs too).
+const fs::path kBlenderScript = fs::path(SKYBAKE_SOURCE_DIR) / "tests/data/blender/make_suzanne.py";
 
 std::string blender() {
     return skybake::test::blender_path();
@@ -66,9 +47,7 @@ std::string blender() {
 
 // Runs Blender to write `out`; false (with the reason in `why`) when it fails.
 bool make_suzanne(const fs::path& out, const std::string& kind, std::string& why) {
-    const fs::path script = out.parent_path() / "make_suzanne.py";
-    std::ofstream(script) << kBlenderScript;
-    const std::string cmd = "'" + blender() + "' -b --factory-startup --python '" + script.string() + "' -- '" +
+    const std::string cmd = "'" + blender() + "' -b --factory-startup --python '" + kBlenderScript.string() + "' -- '" +
                             out.string() + "' " + kind + " > '" + out.string() + ".log' 2>&1";
     if (std::system(cmd.c_str()) != 0 || !fs::exists(out)) {
         why = skybake::read_file(out.string() + ".log");

@@ -1,12 +1,16 @@
 // skybake sky sh [--model W.json | --preset P | --atmosphere A.json] --sun-elevation-deg E [--sun-azimuth-deg A]
 //                [--altitude-km H] [--order L] [--rule R] [--device D] -o light.json [--json]
-// The sky as RGB spherical harmonics, for PRT relighting (skybake/prt.h).
+//                [--gltf MODEL.glb -o LIT.glb [--cube-size N]]
+// The sky as RGB spherical harmonics, for PRT relighting (skybake/prt.h);
+// or, written into a glTF document, as an EXT_lights_image_based light
+// (order-2 irradiance and a radiance cube) for engines that read it.
 #include <chrono>
 
 #include "commands.h"
 #include "flags.h"
 #include "sky_common.h"
 #include "skybake/files.h"
+#include "skybake/gltf_asset.h"
 #include "skybake/prt.h"
 #include "skybake/sky_source.h"
 
@@ -17,7 +21,8 @@ void add_sky_sh(CLI::App& group) {
     struct Opts {
         AtmosphereFlags atm;
         ModelFlag model;
-        std::string output, rule = kSkyLightRule, device = "cpu", convention = "skybake";
+        std::string output, gltf, rule = kSkyLightRule, device = "cpu", convention = "skybake";
+        int cube_size = 32;
         double elevation = 30.0, azimuth = 0.0, altitude = 0.0;
         int order = 3;
         bool json = false;
@@ -43,10 +48,31 @@ void add_sky_sh(CLI::App& group) {
                     "Signs of the written coefficients: skybake (no (-1)^m, Ramamoorthi & Hanrahan 2001) or "
                     "condon-shortley ((-1)^m, Sloan 2008 and D3DX: odd-|m| terms negated); the file records it")
         ->capture_default_str();
-    sub->add_option("-o,--output", o->output, "Light JSON file (order, RGB coefficients, sun)")->required();
+    sub->add_option("--gltf", o->gltf,
+                    "A glTF 2.0 document (.glb or .gltf) to write again as -o LIT.glb/.gltf with the sky as an "
+                    "EXT_lights_image_based light: order-2 irradiance SH (Babylon.js's basis) and a radiance cube");
+    sub->add_option("--cube-size", o->cube_size, "With --gltf: texels along each face of the radiance cube")
+        ->check(integer_in(1, 1024))
+        ->capture_default_str();
+    sub->add_option("-o,--output", o->output,
+                    "Light JSON file (order, RGB coefficients, sun); with --gltf, the .glb or .gltf to write")
+        ->required();
     add_json_flag(*sub, o->json);
     sub->callback([o, sub] {
-        check_output_path(o->output, {".json"}, "--output");
+        const bool gltf = !o->gltf.empty();
+        if (gltf)
+            check_output_path(o->output, {".glb", ".gltf"}, "--output");
+        else
+            check_output_path(o->output, {".json"}, "--output");
+        if (!gltf && sub->count("--cube-size"))
+            throw UsageError("--cube-size is for the light written into a glTF document (--gltf)", "--cube-size");
+        if (gltf && sub->count("--order") && o->order != 2)
+            throw UsageError("EXT_lights_image_based holds order 2 (9 coefficients); leave --order out", "--order");
+        if (gltf && sub->count("--sh-convention"))
+            throw UsageError("EXT_lights_image_based fixes its SH convention (Babylon.js's); leave --sh-convention out",
+                             "--sh-convention");
+        if (gltf && (o->cube_size & (o->cube_size - 1)) != 0)
+            throw UsageError(fmt::format("--cube-size {} is not a power of two", o->cube_size), "--cube-size");
         const SphereRule rule = parse_flag("--rule", [&] { return parse_rule(o->rule); });
         if (rule.kind == RuleKind::Phong)
             throw UsageError(fmt::format("'{}' integrates against a Phong lobe; use a horizon, lebedev, design, "
@@ -63,6 +89,31 @@ void add_sky_sh(CLI::App& group) {
         s.sun_elevation_deg = o->elevation;
         s.sun_azimuth_deg = o->azimuth;
         s.altitude_km = o->altitude;
+        if (gltf) {
+            GltfAsset doc = parse_flag("--gltf", [&] { return GltfAsset::load(o->gltf); });
+            const auto t0 = std::chrono::steady_clock::now();
+            ImageBasedLight ibl = sky_image_based_light(sky, s, rule, o->cube_size);
+            const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            const glm::vec3 e0 = ibl.irradiance[0];
+            doc.set_image_based_light(std::move(ibl));
+            doc.save(o->output);
+            if (o->json) {
+                print_json({{"output", o->output},
+                            {"order", 2},
+                            {"rule", rule.spec},
+                            {"extension", "EXT_lights_image_based"},
+                            {"cube_size", o->cube_size},
+                            {"source", sky.method_name()},
+                            {"seconds", seconds},
+                            {"irradiance_00", {e0.x, e0.y, e0.z}}});
+                return;
+            }
+            info("sky ({}) at sun elevation {} deg, altitude {} km -> EXT_lights_image_based (order 2 with {}, "
+                 "{}x{} cube) in {:.2f} ms; wrote {}",
+                 sky.method_name(), o->elevation, o->altitude, rule.spec, o->cube_size, o->cube_size, seconds * 1e3,
+                 o->output);
+            return;
+        }
         const SkyProjector projector(o->order, rule);
         const auto t0 = std::chrono::steady_clock::now();
         const ShLight light = projector.project(sky, s);

@@ -13,11 +13,14 @@
 // with those attributes added to each primitive.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <filesystem>
 #include <memory>
 #include <string>
 #include <string_view>
+
+#include <glm/vec3.hpp>
 
 #include "skybake/mesh.h"
 
@@ -48,6 +51,8 @@ namespace skybake {
 //   - asset.generator gets "skybake" appended;
 //   - with set_occlusion_texture(), one image and texture are appended, and
 //     the baked primitives' materials get an occlusionTexture;
+//   - with set_image_based_light(), six images and one EXT_lights_image_based
+//     light are appended, and the default scene uses that light;
 //   - buffers[0].byteLength grows; in a .glb buffer 0 is the BIN chunk (no
 //     uri), in a .gltf it is embedded as a base64 data URI;
 //   - relative URIs of images and of other buffers are rewritten to stay
@@ -57,6 +62,19 @@ namespace skybake {
 // puts it, in its rest pose, and animation is ignored.
 
 // [SECTION] The asset ----------------------------------------------------------------
+
+// An image-based light as EXT_lights_image_based (a vendor extension that
+// Babylon.js reads) defines it: "irradianceCoefficients", 9 RGB values of
+// the irradiance E(n) = Σ_k c_k Y_k(n) in the order l00, l1-1, l10, l11,
+// l2-2, l2-1, l20, l21, l22 of Babylon's basis (skybake/prt.h,
+// sky_image_based_light()), and one mip of the radiance cube map: six
+// square RGBD PNGs (+X, −X, +Y, −Y, +Z, −Z) of `face_size` texels.
+struct ImageBasedLight {
+    std::string name = "skybake sky";
+    std::array<glm::vec3, 9> irradiance{};
+    int face_size = 0;
+    std::array<std::string, 6> faces; // PNG bytes
+};
 
 class GltfAsset {
 public:
@@ -95,6 +113,14 @@ public:
     // With `png` (the image's PNG bytes), a .glb embeds it, named after the
     // file, so that the .glb travels alone; a .gltf names the file.
     void set_occlusion_texture(const std::filesystem::path& image, int uv_set, std::string png = {});
+
+    // Makes save() add `light` as an EXT_lights_image_based light used by
+    // the default scene (scenes[scene], else scenes[0], created when the
+    // document has none); a light the file had stays in the list. The faces
+    // are embedded: in the BIN chunk of a .glb, as data URIs in a .gltf.
+    // Throws skybake::Error ("light") for a face_size that is not a power of
+    // two or faces that are not PNGs.
+    void set_image_based_light(ImageBasedLight light);
 
     // Writes the document to a .glb or .gltf file (temporary file, then
     // rename) with the attributes of mesh() that are new or changed since

@@ -33,6 +33,9 @@ void save_png_srgb8(const std::filesystem::path& path, int width, int height, co
 void save_png16_gray(const std::filesystem::path& path, int width, int height, const std::vector<float>& values);
 // The same PNG, in memory (to embed in a .glb). Throws skybake::Error ("values").
 std::string encode_png16_gray(int width, int height, const std::vector<float>& values);
+// An 8-bit PNG of `channels` (1 grey, 3 RGB, 4 RGBA) interleaved samples per
+// pixel, row-major, top row first, in memory. Throws skybake::Error ("values").
+std::string encode_png8(int width, int height, int channels, const std::vector<std::uint8_t>& samples);
 
 // Reads an EXR or a Radiance .hdr (linear) or a PNG/JPEG (sRGB, decoded to linear).
 // Throws skybake::Error on a missing or corrupt file, and on one whose

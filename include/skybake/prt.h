@@ -18,6 +18,7 @@
 // command line (`skybake prt bake`, `skybake prt relight`, `skybake sky sh`).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -30,6 +31,7 @@
 #include <glm/vec3.hpp>
 
 #include "skybake/bake.h"
+#include "skybake/gltf_asset.h"
 #include "skybake/image.h"
 #include "skybake/mesh.h"
 #include "skybake/neural.h"
@@ -274,6 +276,32 @@ private:
 // Sun transmittance (per channel) from altitude_km towards a sun with
 // cos_sun_zenith, from the optical-length tables; 0 when the ray meets the ground.
 glm::dvec3 sun_transmittance(const SkyModel& tables, double altitude_km, double cos_sun_zenith);
+
+// The sky as an image-based light for other engines (EXT_lights_image_based,
+// which Babylon.js reads; gltf_asset.h writes it):
+//   - irradiance: c_k = Â_l L_k, Â_l = π, 2π/3, π/4 (Ramamoorthi & Hanrahan
+//     2001), L_k the order-2 SH of the sky of sky_light() (horizon handled by
+//     `rule`) in Babylon.js's basis: Condon–Shortley signs, z the polar axis
+//     (Y_1-1 = −√(3/4π) y, Y_10 = √(3/4π) z, Y_11 = −√(3/4π) x, Y_2-2 = √(15/4π)
+//     xy, Y_2-1 = −√(15/4π) yz, Y_20 = √(5/16π) (3z² − 1), Y_21 = −√(15/4π) xz,
+//     Y_22 = √(15/16π) (x² − y²)), over directions of the glTF frame (+y up).
+//     Babylon.js's shading then gives ρ/π E(n), as relight() does unshadowed;
+//   - faces: the sky's radiance (per unit sun irradiance, without the sun's
+//     disc, which is the direct light) at each texel centre of an OpenGL cube
+//     map in the glTF frame (face +X: direction (1, −t, −s), −X: (−1, −t, s),
+//     +Y: (s, 1, t), −Y: (s, −1, −t), +Z: (s, −t, 1), −Z: (−s, −t, −1), with
+//     s, t in (−1, 1) from the left column and the top row), one mip of
+//     face_size², RGBD-encoded as Babylon.js decodes it (rgb = (c D)^(1/2.2),
+//     alpha D, D = ⌊max(255 / max(c), 1)⌋ / 255, clamped to 1).
+// Throws skybake::Error as sky_light(), and ("face_size") for a face size
+// that is not a power of two from 1 to 1024.
+ImageBasedLight sky_image_based_light(const SkySource& sky, const SkyLightSettings& settings, const SphereRule& rule,
+                                      int face_size = 32);
+// Babylon.js's order-2 basis above at unit direction d, in its order.
+std::array<double, 9> babylon_sh_basis(const glm::dvec3& d);
+// The unit direction of texel (column i, row j) of cube face `face` (0..5:
+// +X, −X, +Y, −Y, +Z, −Z) of size n, as above.
+glm::dvec3 cube_face_direction(int face, int i, int j, int n);
 
 // [SECTION] Relighting -----------------------------------------------------------------------
 

@@ -12,7 +12,9 @@
 #include <cctype>
 #include <cstring>
 #include <fstream>
+#include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 
 #include <fmt/format.h>
@@ -141,7 +143,21 @@ struct GltfAsset::State {
     std::filesystem::path occlusion_image; // empty: none
     int occlusion_uv_set = 0;
     std::string occlusion_png; // the image's bytes, embedded by a .glb; empty: referenced by URI
+    std::optional<ImageBasedLight> light;
 };
+
+void GltfAsset::set_image_based_light(ImageBasedLight light) {
+    const int n = light.face_size;
+    if (n < 1 || n > 8192 || (n & (n - 1)) != 0)
+        throw Error(fmt::format("face_size {} is not a power of two from 1 to 8192", n), "light");
+    for (const std::string& face : light.faces)
+        if (face.size() < 8 || face.compare(0, 8, "\x89PNG\r\n\x1a\n") != 0)
+            throw Error("each of the six faces must be PNG bytes", "light");
+    for (const glm::vec3& c : light.irradiance)
+        if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z))
+            throw Error("irradiance coefficients must be finite", "light");
+    state_->light = std::move(light);
+}
 
 void GltfAsset::set_occlusion_texture(const std::filesystem::path& image, int uv_set, std::string png) {
     state_->occlusion_image = image;
@@ -274,6 +290,13 @@ void GltfAsset::save(const std::filesystem::path& path) const {
         ensure_array("images");
         ensure_array("textures");
         ensure_array("materials");
+    }
+    if (s.light) {
+        ensure_array("images");
+        ensure_array("scenes");
+        ensure_array("extensionsUsed");
+        if (!doc.contains("extensions") || !doc["extensions"].is_object())
+            doc["extensions"] = Json::object();
     }
     if (!doc.contains("asset") || !doc["asset"].is_object())
         doc["asset"] = Json::object();
@@ -418,6 +441,53 @@ void GltfAsset::save(const std::filesystem::path& path) const {
                 if (mat < doc["materials"].size() && wired.insert(mat).second)
                     doc["materials"][mat]["occlusionTexture"] = occlusion;
             }
+    }
+
+    if (s.light) {
+        // EXT_lights_image_based: the light at the root, its faces as images
+        // (one mip), and the default scene pointing at it.
+        const ImageBasedLight& l = *s.light;
+        Json faces = Json::array();
+        for (const std::string& png : l.faces) {
+            Json image = {{"mimeType", "image/png"}};
+            if (ext == ".glb") {
+                while (bin.size() % 4)
+                    bin.push_back(0);
+                const std::size_t offset = bin.size();
+                bin.insert(bin.end(), png.begin(), png.end());
+                views.push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", png.size()}});
+                image["bufferView"] = views.size() - 1;
+            } else {
+                image = {{"uri", "data:image/png;base64," + base64(std::vector<unsigned char>(png.begin(), png.end()))}};
+            }
+            doc["images"].push_back(image);
+            faces.push_back(doc["images"].size() - 1);
+        }
+        Json irradiance = Json::array();
+        for (const glm::vec3& c : l.irradiance)
+            irradiance.push_back({c.x, c.y, c.z});
+        Json& root = doc["extensions"]["EXT_lights_image_based"];
+        if (!root.is_object())
+            root = Json::object();
+        if (!root.contains("lights") || !root["lights"].is_array())
+            root["lights"] = Json::array();
+        root["lights"].push_back({{"name", l.name},
+                                  {"intensity", 1.0},
+                                  {"rotation", {0.0, 0.0, 0.0, 1.0}},
+                                  {"irradianceCoefficients", irradiance},
+                                  {"specularImageSize", l.face_size},
+                                  {"specularImages", Json::array({faces})}});
+        const std::size_t light = root["lights"].size() - 1;
+        Json& scenes = doc["scenes"];
+        if (scenes.empty())
+            scenes.push_back(Json::object());
+        std::size_t scene = doc.contains("scene") && doc["scene"].is_number_unsigned() ? doc["scene"].get<std::size_t>() : 0;
+        if (scene >= scenes.size())
+            scene = 0;
+        scenes[scene]["extensions"]["EXT_lights_image_based"] = {{"light", light}};
+        Json& used = doc["extensionsUsed"];
+        if (std::find(used.begin(), used.end(), "EXT_lights_image_based") == used.end())
+            used.push_back("EXT_lights_image_based");
     }
 
     Json& asset = doc["asset"];

@@ -14,6 +14,7 @@
 #include "skybake/error.h"
 #include "skybake/files.h"
 #include "skybake/gltf_asset.h"
+#include "skybake/image_io.h"
 #include "skybake/mesh.h"
 #include "core/test_paths.h"
 
@@ -307,4 +308,63 @@ TEST(GltfAsset, RefusesOtherFormatsAndChangedMeshes) {
     EXPECT_FALSE(fs::exists(input.parent_path() / "out.glb"));
     asset.mesh().positions.pop_back();
     EXPECT_THROW(asset.save(input.parent_path() / "out.obj"), Error);
+}
+
+// EXT_lights_image_based: six PNG faces, the irradiance, the default scene's
+// reference, and the rest of the document untouched; .glb and .gltf.
+TEST(GltfAsset, WritesAnImageBasedLight) {
+    const fs::path input = copy_sample("BoxTextured-glTF-Binary", "BoxTextured.glb", "box-ibl");
+    const Document before = read_document(input);
+    ImageBasedLight light;
+    light.face_size = 2;
+    for (int f = 0; f < 6; ++f)
+        light.faces[std::size_t(f)] = encode_png8(2, 2, 4, std::vector<std::uint8_t>(16, std::uint8_t(40 * f + 1)));
+    for (int k = 0; k < 9; ++k)
+        light.irradiance[std::size_t(k)] = glm::vec3(0.1f * float(k), 1.0f, -0.5f);
+    for (const char* name : {"lit.glb", "lit.gltf"}) {
+        GltfAsset asset = GltfAsset::load(input);
+        asset.set_image_based_light(light);
+        const fs::path out = input.parent_path() / name;
+        asset.save(out);
+        const Document d = read_document(out);
+        const Json& l = d.json["extensions"]["EXT_lights_image_based"]["lights"][0];
+        EXPECT_EQ(l["specularImageSize"], 2);
+        ASSERT_EQ(l["irradianceCoefficients"].size(), 9u);
+        EXPECT_FLOAT_EQ(l["irradianceCoefficients"][4][0].get<float>(), 0.4f);
+        EXPECT_FLOAT_EQ(l["irradianceCoefficients"][8][2].get<float>(), -0.5f);
+        ASSERT_EQ(l["specularImages"].size(), 1u); // one mip
+        ASSERT_EQ(l["specularImages"][0].size(), 6u);
+        for (int f = 0; f < 6; ++f) {
+            const Json& image = d.json["images"][l["specularImages"][0][std::size_t(f)].get<std::size_t>()];
+            std::string bytes;
+            if (image.contains("bufferView")) {
+                const Json& v = d.json["bufferViews"][image["bufferView"].get<std::size_t>()];
+                bytes = d.bin.substr(v.value("byteOffset", std::size_t(0)), v["byteLength"].get<std::size_t>());
+                EXPECT_EQ(image["mimeType"], "image/png");
+            } else {
+                const std::string uri = image["uri"];
+                ASSERT_EQ(uri.rfind("data:image/png;base64,", 0), 0u);
+            }
+            if (!bytes.empty())
+                EXPECT_EQ(bytes, light.faces[std::size_t(f)]) << f;
+        }
+        EXPECT_EQ(d.json["scenes"][d.json.value("scene", 0)]["extensions"]["EXT_lights_image_based"]["light"], 0);
+        const Json& used = d.json["extensionsUsed"];
+        EXPECT_NE(std::find(used.begin(), used.end(), "EXT_lights_image_based"), used.end());
+        EXPECT_FALSE(d.json.contains("extensionsRequired"));
+        EXPECT_EQ(d.json["meshes"], before.json["meshes"]);
+        EXPECT_EQ(d.json["materials"], before.json["materials"]);
+        // The written file reads again, with the same geometry.
+        EXPECT_EQ(GltfAsset::load(out).mesh().vertex_count(), asset.mesh().vertex_count());
+    }
+    GltfAsset asset = GltfAsset::load(input);
+    ImageBasedLight bad = light;
+    bad.face_size = 3;
+    EXPECT_THROW(asset.set_image_based_light(bad), Error);
+    bad = light;
+    bad.faces[2] = "not a png";
+    EXPECT_THROW(asset.set_image_based_light(bad), Error);
+    bad = light;
+    bad.irradiance[1].y = std::nanf("");
+    EXPECT_THROW(asset.set_image_based_light(bad), Error);
 }
