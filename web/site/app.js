@@ -5,17 +5,19 @@
 // (scripts, not fetched files, so that the page opens from file:// too).
 // Everything else is bundled into one script by esbuild at build time.
 import {
-  ACESFilmicToneMapping,
   Box3,
+  CustomToneMapping,
   BufferAttribute,
   Color,
   DirectionalLight,
+  DoubleSide,
   Mesh,
-  MeshStandardMaterial,
+  MeshLambertMaterial,
   PlaneGeometry,
   PCFSoftShadowMap,
   PerspectiveCamera,
   Scene,
+  ShaderChunk,
   SRGBColorSpace,
   Vector3,
   WebGLRenderer,
@@ -65,18 +67,64 @@ function sunTransmittance(atm, elevationDeg) {
   return tau.map((x) => Math.exp(-x));
 }
 
+// skybake's tone curve (src/core/tone_curve.h: Narkowicz's ACES fit at
+// linear × 2^EV), so that the page looks as `skybake view` does; three.js
+// then applies the sRGB encoding, as skybake does.
+ShaderChunk.tonemapping_pars_fragment = ShaderChunk.tonemapping_pars_fragment.replace(
+  'vec3 CustomToneMapping( vec3 color ) { return color; }',
+  `vec3 CustomToneMapping( vec3 color ) {
+    vec3 x = color * toneMappingExposure;
+    return clamp( ( x * ( 2.51 * x + 0.03 ) ) / ( x * ( 2.43 * x + 0.59 ) + 0.14 ), 0.0, 1.0 );
+  }`,
+);
+
+// The camera of `skybake view` and the previews (preview_camera() in
+// src/bake/preview.cpp): looking at the bounds' centre from azimuth and
+// elevation (degrees; azimuth from +z towards +x), at the distance that fits
+// the bounds' sphere in the field of view.
+function previewCamera(camera, box, azimuthDeg, elevationDeg, fovYDeg, aspect) {
+  const centre = box.getCenter(new Vector3());
+  const radius = Math.max(0.5 * box.getSize(new Vector3()).length(), 1e-20);
+  const az = (azimuthDeg * Math.PI) / 180, el = (elevationDeg * Math.PI) / 180;
+  const toEye = new Vector3(Math.cos(el) * Math.sin(az), Math.sin(el), Math.cos(el) * Math.cos(az));
+  const half = (0.5 * fovYDeg * Math.PI) / 180;
+  const fit = Math.min(Math.sin(half), Math.sin(Math.atan(Math.tan(half) * aspect)));
+  camera.fov = fovYDeg;
+  camera.aspect = aspect;
+  camera.position.copy(centre).addScaledVector(toEye, (radius / fit) * 1.02);
+  camera.up.set(0, 1, 0);
+  if (Math.abs(toEye.y) > 0.999) camera.up.set(0, 0, -1);
+  camera.lookAt(centre);
+  camera.updateProjectionMatrix();
+  return centre;
+}
+
 async function main() {
   const data = window.SKYBAKE_SITE;
   if (!data) throw new Error('data.js is missing or did not load (write the site again with `skybake web`)');
   const canvas = document.getElementById('view');
   if (!canvas.getContext('webgl2')) throw new Error('this browser has no WebGL 2');
+  // URL settings: elevation, azimuth, exposure (EV) as in the panel; view=AZ,EL
+  // and fov as `skybake view --set view=AZ,EL --set fov=F`; ground=off (the
+  // viewer draws none) and aa=off (one sample per pixel, `--set samples=1`).
+  const params = new URLSearchParams(window.location.search);
+  const number = (key, fallback, lo, hi) => {
+    if (!params.has(key)) return fallback;
+    const x = Number(params.get(key));
+    if (!Number.isFinite(x) || x < lo || x > hi) throw new Error(`?${key}=${params.get(key)} is not a number in [${lo}, ${hi}]`);
+    return x;
+  };
+  // The default view is the viewer's azimuth, lower (5° above the model, not 30°) to show the sky.
+  const viewParam = (params.get('view') ?? '35,5').split(',').map(Number);
+  if (viewParam.length !== 2 || !viewParam.every(Number.isFinite)) throw new Error(`?view=${params.get('view')} is not AZIMUTH,ELEVATION in degrees`);
+  const fov = number('fov', 35, 2, 160);
 
-  const renderer = new WebGLRenderer({ canvas, antialias: true, preserveDrawingBuffer: true });
+  const renderer = new WebGLRenderer({ canvas, antialias: params.get('aa') !== 'off', preserveDrawingBuffer: true });
   renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
-  renderer.toneMapping = ACESFilmicToneMapping;
+  renderer.toneMapping = CustomToneMapping;
   renderer.outputColorSpace = SRGBColorSpace;
   renderer.shadowMap.enabled = true;
-  renderer.shadowMap.type = PCFSoftShadowMap;
+  renderer.shadowMap.type = PCFSoftShadowMap; // 3×3 bilinear PCF taps, as the viewer filters
   const scene = new Scene();
   scene.background = new Color(0, 0, 0);
 
@@ -86,14 +134,17 @@ async function main() {
 
   const gltf = await parseGlb(base64ToBuffer(data.model));
   const model = gltf.scene;
-  const box = new Box3().setFromObject(model);
+  const box = new Box3().setFromObject(model, true); // precise: the vertices in world space, as skybake bounds the mesh
   const size = box.getSize(new Vector3()).length() || 1;
+  const radius = 0.5 * size;
   const centre = box.getCenter(new Vector3());
 
   // The sky's light through the bake: the transfer where the file has one
   // ('PRT'), its AO (_AO, else COLOR_0) times the unshadowed SH light ('AO'),
   // or none ('sun': the sun alone). Each mesh gets a material per mode the
-  // file allows; the panel switches between them.
+  // file allows; the panel switches between them. Lambert, as the bake
+  // assumes; the albedo is a PRT bake's _ALBEDO where the file has it (what
+  // `skybake view` draws), else the material's colour and image.
   const hooks = [];
   const modes = new Set(['sun']);
   const meshes = [];
@@ -102,17 +153,22 @@ async function main() {
     o.castShadow = true;
     o.receiveShadow = true;
     const a = o.geometry.attributes;
-    const base = o.material && o.material.color ? o.material.color : new Color(0.8, 0.8, 0.8);
-    const make = () => new MeshStandardMaterial({ color: base.clone(), roughness: 1, metalness: 0, map: o.material?.map ?? null });
+    const perVertex = a._albedo && a._albedo.itemSize === 3;
+    const base = perVertex ? new Color(1, 1, 1) : o.material && o.material.color ? o.material.color : new Color(0.8, 0.8, 0.8);
+    const albedo = perVertex ? '_albedo' : base.toArray();
+    const side = o.material?.side;
+    // Both faces cast shadows, as in the viewer's depth pass (three's default is the back faces).
+    const make = () => new MeshLambertMaterial({ color: base.clone(), map: o.material?.map ?? null, side, shadowSide: DoubleSide });
     const materials = { sun: make() };
+    if (perVertex) skybakeLighting(materials.sun, { mode: 'none', albedo }); // the albedo, no sky light
     if (data.prt && a._prt_0) {
       materials.PRT = make();
-      hooks.push(skybakeLighting(materials.PRT, { mode: 'prt', prtGlsl: data.prt.glsl, attributes: data.prt.attributes, order: data.prt.order, albedo: base.toArray() }));
+      hooks.push(skybakeLighting(materials.PRT, { mode: 'prt', prtGlsl: data.prt.glsl, attributes: data.prt.attributes, order: data.prt.order, albedo }));
       modes.add('PRT');
     }
     if (a._ao || a.color) {
       materials.AO = make();
-      hooks.push(skybakeLighting(materials.AO, { mode: 'ao', aoAttribute: a._ao ? '_ao' : 'color', order: 3, albedo: base.toArray() }));
+      hooks.push(skybakeLighting(materials.AO, { mode: 'ao', aoAttribute: a._ao ? '_ao' : 'color', order: 3, albedo }));
       modes.add('AO');
     }
     meshes.push({ mesh: o, materials });
@@ -130,32 +186,52 @@ async function main() {
   const groundAlbedo = data.weights.atmosphere?.ground_albedo ?? [0.1, 0.1, 0.1];
   const groundGeometry = new PlaneGeometry(size * 200, size * 200).rotateX(-Math.PI / 2);
   groundGeometry.setAttribute('_ao', new BufferAttribute(new Float32Array(groundGeometry.attributes.position.count).fill(1), 1));
-  const groundMaterial = new MeshStandardMaterial({ color: new Color(...groundAlbedo), roughness: 1, metalness: 0 });
+  const groundMaterial = new MeshLambertMaterial({ color: new Color(...groundAlbedo) });
   hooks.push(skybakeLighting(groundMaterial, { mode: 'ao', aoAttribute: '_ao', order: 3, albedo: groundAlbedo }));
   const ground = new Mesh(groundGeometry, groundMaterial);
   ground.position.set(centre.x, box.min.y - 1e-3 * size, centre.z);
   ground.receiveShadow = true;
-  scene.add(ground);
+  if (params.get('ground') !== 'off') scene.add(ground); // `skybake view` draws no ground
 
+  // The sun's shadow map as `skybake view` makes it: 2048², an orthographic
+  // frustum around the bounds' sphere, looked up 1.5 texels along the normal
+  // and filtered by 3×3 bilinear comparisons (three's PCFSoftShadowMap).
   const sun = new DirectionalLight(0xffffff, 1);
   sun.castShadow = true;
   sun.shadow.mapSize.set(2048, 2048);
-  const r = size * 0.75;
-  Object.assign(sun.shadow.camera, { left: -r, right: r, top: r, bottom: -r, near: 0.01 * size, far: 4 * size });
+  Object.assign(sun.shadow.camera, { left: -radius, right: radius, top: radius, bottom: -radius, near: 0.5 * radius, far: 3.5 * radius });
+  sun.shadow.normalBias = (1.5 * 2 * radius) / 2048;
+  sun.shadow.bias = -1e-4;
   sun.target.position.copy(centre);
   scene.add(sun, sun.target);
 
-  const camera = new PerspectiveCamera(45, 1, size * 0.01, size * 100);
-  camera.position.copy(centre).add(new Vector3(0.8, 0.22, 1.0).multiplyScalar(size * 0.8));
+  const camera = new PerspectiveCamera();
+  const resetCamera = () => previewCamera(camera, box, viewParam[0], viewParam[1], fov, canvas.clientWidth / Math.max(1, canvas.clientHeight));
+  resetCamera();
   const controls = new OrbitControls(camera, canvas);
   controls.target.copy(centre);
   controls.update();
+  // The depth range of the viewer (the bounds' sphere, ±1.5 radii around the
+  // centre's distance); with the ground, from near the eye to its far edge.
+  const groundShown = params.get('ground') !== 'off';
+  const fitDepthRange = () => {
+    const dist = camera.position.distanceTo(centre);
+    const near = groundShown ? 0.01 * dist : Math.max(dist - 1.5 * radius, 1e-3 * dist);
+    const far = dist + (groundShown ? 200 * size : 1.5 * radius);
+    if (camera.near !== near || camera.far !== far) {
+      camera.near = near;
+      camera.far = far;
+      camera.updateProjectionMatrix();
+    }
+  };
+  fitDepthRange();
 
   // Controls.
   const ui = (id) => document.getElementById(id);
   const state = { elevation: 25, azimuth: 135, exposure: 0, auto: true, animate: false };
-  const params = new URLSearchParams(window.location.search);
-  for (const k of ['elevation', 'azimuth', 'exposure']) if (params.has(k)) state[k] = Number(params.get(k));
+  state.elevation = number('elevation', state.elevation, -20, 90);
+  state.azimuth = number('azimuth', state.azimuth, -360, 360);
+  state.exposure = number('exposure', state.exposure, -64, 64);
   if (params.has('exposure')) state.auto = false;
   ui('elevation').value = state.elevation;
   ui('azimuth').value = state.azimuth;
@@ -214,7 +290,7 @@ async function main() {
     const elevation = Math.max(-20, Math.min(90, state.elevation));
     sky.setSun(elevation, state.azimuth);
     const s = sky.material.uniforms.sunPosition.value;
-    sun.position.copy(centre).addScaledVector(s, 2 * size);
+    sun.position.copy(centre).addScaledVector(s, 2 * radius);
     const key = `${elevation.toFixed(2)} ${state.azimuth.toFixed(2)}`;
     if (key !== lightKey) {
       lightKey = key;
@@ -237,6 +313,7 @@ async function main() {
     ui('ev').textContent = `${ev >= 0 ? '+' : ''}${ev.toFixed(2)} EV`;
     resize();
     controls.update();
+    fitDepthRange();
     renderer.render(scene, camera);
     window.skybakeSiteFrames = (window.skybakeSiteFrames ?? 0) + 1;
     requestAnimationFrame(frame);
@@ -245,6 +322,7 @@ async function main() {
   // For tests and scripts: the mean RGB (0–255) of a rectangle of the view,
   // in fractions of its size from the top left, drawn and read at once.
   const regionMean = (x0, y0, x1, y1) => {
+    fitDepthRange();
     renderer.render(scene, camera);
     const gl = renderer.getContext();
     const W = gl.drawingBufferWidth, H = gl.drawingBufferHeight;
@@ -256,7 +334,19 @@ async function main() {
     for (let i = 0; i < px.length; i += 4) for (let k = 0; k < 3; ++k) m[k] += px[i + k];
     return m.map((v) => v / (w * h));
   };
-  window.skybakeSite = { shading, regionMean };
+  // The whole view, RGBA 8-bit, top row first.
+  const pixels = () => {
+    fitDepthRange();
+    renderer.render(scene, camera);
+    const gl = renderer.getContext();
+    const W = gl.drawingBufferWidth, H = gl.drawingBufferHeight;
+    const px = new Uint8Array(W * H * 4);
+    gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    const out = new Uint8Array(px.length);
+    for (let y = 0; y < H; ++y) out.set(px.subarray((H - 1 - y) * W * 4, (H - y) * W * 4), y * W * 4);
+    return Array.from(out);
+  };
+  window.skybakeSite = { shading, regionMean, pixels };
 }
 
 main().catch((e) => {

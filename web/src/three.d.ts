@@ -20,8 +20,8 @@ export declare class NeuralSky extends Mesh<BoxGeometry, ShaderMaterial> {
 }
 
 export interface SkybakeLightingOptions {
-  /** 'prt': the _prt_i attributes through prtGlsl; 'ao': an AO attribute times the unshadowed order-2 light. */
-  mode?: 'prt' | 'ao';
+  /** 'prt': the _prt_i attributes through prtGlsl; 'ao': an AO attribute times the unshadowed order-2 light; 'none': only a per-vertex albedo. */
+  mode?: 'prt' | 'ao' | 'none';
   /** `skybake prt export BAKED.glb --format glsl-es` */
   prtGlsl?: string;
   /** Number of _prt_i attributes (the sidecar's "attributes"). */
@@ -29,7 +29,8 @@ export interface SkybakeLightingOptions {
   order?: number;
   /** The AO attribute: '_ao' (glTF _AO, lower-cased by GLTFLoader) or 'color' (COLOR_0's red). */
   aoAttribute?: string;
-  albedo?: [number, number, number];
+  /** Linear RGB, or a per-vertex attribute ('_albedo': a PRT bake's _ALBEDO) that also multiplies the material's colour. */
+  albedo?: [number, number, number] | string;
 }
 
 export declare function skybakeLighting(

@@ -112,35 +112,46 @@ export class NeuralSky extends Mesh {
 //               GLTFLoader lower-cases glTF's _PRT_i) and prtGlsl, the text of
 //               `skybake prt export BAKED.glb --format glsl-es`;
 //   mode 'ao':  the AO attribute `aoAttribute` (default '_ao'; 'color' reads
-//               COLOR_0's red) times the unshadowed SH irradiance, order 2.
-// The light is added as emissive radiance (albedo × light) so that three's
-// own lights (the sun) keep working. Returns an object whose update(light)
-// takes NeuralSky.shLight()'s result each frame.
+//               COLOR_0's red) times the unshadowed SH irradiance, order 2;
+//   mode 'none': no sky light, only the albedo attribute below.
+// albedo: [r, g, b] (linear), or the name of a per-vertex attribute ('_albedo',
+// the lower-cased _ALBEDO of a PRT bake), which then also multiplies the
+// material's colour for three's own lights. The light is added as emissive
+// radiance (albedo × light) so that three's own lights (the sun) keep
+// working. Returns an object whose update(light) takes NeuralSky.shLight()'s
+// result each frame.
 export function skybakeLighting(material, { mode = 'prt', prtGlsl, attributes = 0, order = 3, aoAttribute = '_ao', albedo = [1, 1, 1] } = {}) {
   const count = (order + 1) * (order + 1);
   if (mode === 'ao' && order < 2) throw new Error('skybake: ao lighting needs an SH light of order 2 or more');
-  const uniformCount = mode === 'prt' ? count : 9;
-  const uniforms = {
-    skybakeLight: { value: Array.from({ length: uniformCount }, () => new Vector3()) },
-    skybakeAlbedo: { value: new Vector3(...albedo) },
-  };
+  const uniformCount = mode === 'prt' ? count : mode === 'ao' ? 9 : 1;
   if (mode === 'prt') {
     checkGlsl(prtGlsl, 'skybake_prt_diffuse');
     if (!Number.isInteger(attributes) || attributes < 1) throw new Error('skybake: prt lighting needs the number of _prt_i attributes');
-  } else if (mode !== 'ao') {
-    throw new Error(`skybake: lighting mode '${mode}' is not 'prt' or 'ao'`);
+  } else if (mode !== 'ao' && mode !== 'none') {
+    throw new Error(`skybake: lighting mode '${mode}' is not 'prt', 'ao' or 'none'`);
   }
+  const albedoAttribute = typeof albedo === 'string' ? albedo : null;
+  if (albedoAttribute !== null && !/^[A-Za-z_][A-Za-z0-9_]*$/.test(albedoAttribute))
+    throw new Error(`skybake: albedo attribute '${albedoAttribute}' is not a GLSL name`);
+  const uniforms = {
+    skybakeLight: { value: Array.from({ length: uniformCount }, () => new Vector3()) },
+    skybakeAlbedo: { value: albedoAttribute === null ? new Vector3(...albedo) : new Vector3(1, 1, 1) },
+  };
   material.onBeforeCompile = (shader) => {
     Object.assign(shader.uniforms, uniforms);
-    let decl = `uniform vec3 skybakeLight[${uniformCount}];\nuniform vec3 skybakeAlbedo;\nvarying vec3 vSkybakeSky;\n`;
+    let decl = `uniform vec3 skybakeLight[${uniformCount}];\nvarying vec3 vSkybakeSky;\nvarying vec3 vSkybakeAlbedo;\n`;
+    decl += albedoAttribute === null ? 'uniform vec3 skybakeAlbedo;\n' : `attribute vec3 ${albedoAttribute};\n`;
+    const albedoValue = albedoAttribute === null ? 'skybakeAlbedo' : albedoAttribute;
     let body;
     if (mode === 'prt') {
       for (let i = 0; i < attributes; ++i) decl += `attribute vec4 _prt_${i};\n`;
       // skybake_prt_diffuse(vec4 prt[M], vec3 light[coefficients], vec3 albedo);
       // with 3 channels each reads its own component of the light.
       body = `{ vec4 skybake_t[${attributes}] = vec4[${attributes}](${Array.from({ length: attributes }, (_, i) => `_prt_${i}`).join(', ')});
-        vSkybakeSky = skybake_prt_diffuse(skybake_t, skybakeLight, skybakeAlbedo); }`;
+        vSkybakeSky = skybake_prt_diffuse(skybake_t, skybakeLight, ${albedoValue}); }`;
       decl += prtGlsl;
+    } else if (mode === 'none') {
+      body = 'vSkybakeSky = vec3(0.0);';
     } else {
       const ao = aoAttribute === 'color' ? 'color.r' : aoAttribute;
       // COLOR_0 without vertexColors: three declares no `color`, so declare it
@@ -156,13 +167,18 @@ export function skybakeLighting(material, { mode = 'prt', prtGlsl, attributes = 
           + 0.785398163 * (1.092548 * x * y * skybakeLight[4] + 1.092548 * y * z * skybakeLight[5]
              + 0.315392 * (3.0 * z * z - 1.0) * skybakeLight[6] + 1.092548 * x * z * skybakeLight[7]
              + 0.546274 * (x * x - y * y) * skybakeLight[8]);
-        vSkybakeSky = skybakeAlbedo / 3.14159265 * max(E, vec3(0.0)) * ${ao}; }`;
+        vSkybakeSky = ${albedoValue} / 3.14159265 * max(E, vec3(0.0)) * ${ao}; }`;
     }
+    body += `\nvSkybakeAlbedo = ${albedoAttribute === null ? 'vec3(1.0)' : albedoAttribute};`;
     shader.vertexShader = decl + shader.vertexShader.replace('#include <begin_vertex>', `#include <begin_vertex>\n${body}`);
-    shader.fragmentShader = 'varying vec3 vSkybakeSky;\n' +
-      shader.fragmentShader.replace('#include <emissivemap_fragment>', '#include <emissivemap_fragment>\ntotalEmissiveRadiance += vSkybakeSky;');
+    // The per-vertex albedo multiplies the material's colour for three's own
+    // lights; the sky's light carries it already.
+    shader.fragmentShader = 'varying vec3 vSkybakeSky;\nvarying vec3 vSkybakeAlbedo;\n' +
+      shader.fragmentShader
+        .replace('#include <color_fragment>', '#include <color_fragment>\ndiffuseColor.rgb *= vSkybakeAlbedo;')
+        .replace('#include <emissivemap_fragment>', '#include <emissivemap_fragment>\ntotalEmissiveRadiance += vSkybakeSky;');
   };
-  material.customProgramCacheKey = () => `skybake-${mode}-${attributes}-${order}-${aoAttribute}`;
+  material.customProgramCacheKey = () => `skybake-${mode}-${attributes}-${order}-${aoAttribute}-${albedoAttribute}`;
   material.needsUpdate = true;
   return {
     uniforms,

@@ -7,7 +7,7 @@ import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawn, spawnSync } from 'node:child_process';
 import { createServer } from 'node:net';
-import { existsSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { pathToFileURL } from 'node:url';
@@ -143,5 +143,59 @@ test('skybake web: PRT and AO sites, and their errors', async () => {
     } finally {
       await browser.close();
     }
+  }
+});
+
+// The page against `skybake view --screenshot` of the same model, camera,
+// sun and exposure (one sample per pixel on both sides, no ground: the viewer
+// draws none), at noon, sunset and twilight: PSNR of the 8-bit images.
+test('skybake web matches skybake view (PSNR ≥ 30 dB at three suns)', async () => {
+  const engine = join(process.env.SKYBAKE_ASSIMP_MODELS || '/usr/share/assimp/models', 'glTF2', '2CylinderEngine-glTF-Binary', '2CylinderEngine.glb');
+  const baked = join(dir, 'engine_prt.glb');
+  let r = skybake('prt', 'bake', engine, '--order', '3', '--rule', 'lebedev:194', '-o', baked);
+  assert.equal(r.code, 0, r.err);
+  const site = join(dir, 'site_engine');
+  r = skybake('web', baked, '--model', weights, '-o', site);
+  assert.equal(r.code, 0, r.err);
+  const [W, H, view] = [960, 540, '20,8'];
+  const { browser, page, errors } = await open('about:blank', [`--window-size=${W},${H}`]);
+  await page.setViewport({ width: W, height: H });
+  try {
+    for (const [name, elevation, azimuth, ev] of [['noon', 60, 60, 2], ['sunset', 3, 60, 4.5], ['twilight', -4, 60, 10]]) {
+      const png = join(dir, `view_${name}.png`);
+      r = skybake('view', baked, '--screenshot', png, '--model', weights, '--size', `${W}x${H}`, '--sun-elevation-deg', String(elevation),
+        '--sun-azimuth-deg', String(azimuth), '--set', `view=${view}`, '--set', `exposure=${ev}`, '--set', 'samples=1');
+      assert.equal(r.code, 0, r.err);
+      await page.goto(`${pathToFileURL(join(site, 'index.html')).href}?elevation=${elevation}&azimuth=${azimuth}&view=${view}&exposure=${ev}&ground=off&aa=off`);
+      await page.waitForFunction('(window.skybakeSiteFrames ?? 0) >= 2 || window.skybakeSite?.error', { timeout: 120000 });
+      assert.equal(await page.evaluate('window.skybakeSite.error'), undefined);
+      const reference = `data:image/png;base64,${readFileSync(png).toString('base64')}`;
+      const { psnr, width, height, mean } = await page.evaluate(async (url) => {
+        const img = new Image();
+        img.src = url;
+        await img.decode();
+        const c = document.createElement('canvas');
+        [c.width, c.height] = [img.width, img.height];
+        const ctx = c.getContext('2d');
+        ctx.drawImage(img, 0, 0);
+        const ref = ctx.getImageData(0, 0, img.width, img.height).data;
+        const got = window.skybakeSite.pixels();
+        let se = 0, sum = 0;
+        for (let i = 0; i < ref.length; i += 4)
+          for (let k = 0; k < 3; ++k) {
+            se += (got[i + k] - ref[i + k]) ** 2;
+            sum += ref[i + k];
+          }
+        const n = (ref.length / 4) * 3;
+        return { psnr: 10 * Math.log10((255 * 255 * n) / Math.max(se, 1e-9)), width: img.width, height: img.height, mean: sum / n };
+      }, reference);
+      console.log(`${name} (sun ${elevation}°, ${ev} EV): PSNR ${psnr.toFixed(2)} dB against skybake view (mean ${mean.toFixed(1)} of 255)`);
+      assert.deepEqual([width, height], [W, H]);
+      assert.ok(mean > 8, `the viewer's image is too dark to compare (${mean})`);
+      assert.ok(psnr >= 30, `${name}: ${psnr.toFixed(2)} dB`);
+    }
+    assert.deepEqual(errors, []);
+  } finally {
+    await browser.close();
   }
 });
