@@ -104,9 +104,10 @@ async function main() {
   if (!data) throw new Error('data.js is missing or did not load (write the site again with `skybake web`)');
   const canvas = document.getElementById('view');
   if (!canvas.getContext('webgl2')) throw new Error('this browser has no WebGL 2');
-  // URL settings: elevation, azimuth, exposure (EV) as in the panel; view=AZ,EL
-  // and fov as `skybake view --set view=AZ,EL --set fov=F`; ground=off (the
-  // viewer draws none) and aa=off (one sample per pixel, `--set samples=1`).
+  // URL settings: elevation, azimuth, exposure (EV) as in the panel; view=AZ,EL,
+  // fov, shading, phong and specular as `skybake view --set KEY=VALUE`;
+  // ground=off (the viewer draws none) and aa=off (one sample per pixel,
+  // `--set samples=1`).
   const params = new URLSearchParams(window.location.search);
   const number = (key, fallback, lo, hi) => {
     if (!params.has(key)) return fallback;
@@ -118,6 +119,9 @@ async function main() {
   const viewParam = (params.get('view') ?? '35,5').split(',').map(Number);
   if (viewParam.length !== 2 || !viewParam.every(Number.isFinite)) throw new Error(`?view=${params.get('view')} is not AZIMUTH,ELEVATION in degrees`);
   const fov = number('fov', 35, 2, 160);
+  // The glossy layer, as `skybake view --set phong=… --set specular=…`.
+  const phong = number('phong', 32, 0.5, 100000);
+  const specular = number('specular', 0.25, 0, 100);
 
   const renderer = new WebGLRenderer({ canvas, antialias: params.get('aa') !== 'off', preserveDrawingBuffer: true });
   renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
@@ -165,6 +169,15 @@ async function main() {
       materials.PRT = make();
       hooks.push(skybakeLighting(materials.PRT, { mode: 'prt', prtGlsl: data.prt.glsl, attributes: data.prt.attributes, order: data.prt.order, albedo }));
       modes.add('PRT');
+      if (a._shading) {
+        // DPRT: the glossy layer through the shading coefficient A (_SHADING).
+        materials['PRT + glossy'] = make();
+        hooks.push(skybakeLighting(materials['PRT + glossy'], {
+          mode: 'prt', prtGlsl: data.prt.glsl, attributes: data.prt.attributes, order: data.prt.order, albedo,
+          glossy: { attribute: '_shading', exponent: phong, specular },
+        }));
+        modes.add('PRT + glossy');
+      }
     }
     if (a._ao || a.color) {
       materials.AO = make();
@@ -173,7 +186,11 @@ async function main() {
     }
     meshes.push({ mesh: o, materials });
   });
-  const shading = modes.has('PRT') ? 'PRT' : modes.has('AO') ? 'AO' : 'sun';
+  // ?shading= as `skybake view --set shading=`: prt, dprt, ao or sun.
+  const asked = { prt: 'PRT', dprt: 'PRT + glossy', ao: 'AO', sun: 'sun' }[params.get('shading') ?? ''];
+  if (params.has('shading') && !asked) throw new Error(`?shading=${params.get('shading')} is not prt, dprt, ao or sun`);
+  if (asked && !modes.has(asked)) throw new Error(`?shading=${params.get('shading')}: this model has no data for it`);
+  const shading = asked ?? (modes.has('PRT') ? 'PRT' : modes.has('AO') ? 'AO' : 'sun');
   const setShading = (mode) => {
     for (const { mesh, materials } of meshes) mesh.material = materials[mode] ?? materials.sun;
   };
@@ -248,7 +265,7 @@ async function main() {
     a.download = 'skybake.png';
     a.click();
   };
-  for (const mode of ['PRT', 'AO', 'sun'].filter((m) => modes.has(m))) ui('shading').add(new Option(mode, mode, mode === shading, mode === shading));
+  for (const mode of ['PRT', 'PRT + glossy', 'AO', 'sun'].filter((m) => modes.has(m))) ui('shading').add(new Option(mode, mode, mode === shading, mode === shading));
   ui('shading').onchange = (e) => setShading(e.target.value);
   // Shift-drag on the view moves the sun (the orbit camera takes plain drags).
   let drag = null;

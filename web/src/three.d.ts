@@ -31,7 +31,15 @@ export interface SkybakeLightingOptions {
   aoAttribute?: string;
   /** Linear RGB, or a per-vertex attribute ('_albedo': a PRT bake's _ALBEDO) that also multiplies the material's colour. */
   albedo?: [number, number, number] | string;
+  /** With mode 'prt': the DPRT glossy layer, specular · A · glossyMap(light)(mirror direction). */
+  glossy?: { attribute?: string; exponent?: number; specular?: number } | null;
 }
+
+/** k̂_l = 2π ∫_0^1 t^a P_l(t) dt, the Phong lobe's zonal factors. */
+export declare function phongLobeZonal(l: number, exponent: number): number;
+
+/** The glossy layer of an SH light: an equirectangular RGBA map (row 0 at the zenith) by mirror direction. */
+export declare function glossyMap(light: ShLight, exponent: number, width?: number, height?: number): Float32Array;
 
 export declare function skybakeLighting(
   material: Material,

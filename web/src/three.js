@@ -13,9 +13,9 @@
 // of `skybake prt export BAKED.glb --format glsl-es`, the generators that
 // write every other language. The weights file itself drives the per-frame
 // SH projection in JavaScript (SkyProjector).
-import { BackSide, BoxGeometry, Mesh, ShaderMaterial, Vector3 } from 'three';
+import { BackSide, BoxGeometry, DataTexture, DataUtils, HalfFloatType, LinearFilter, Mesh, RGBAFormat, ClampToEdgeWrapping, RepeatWrapping, ShaderMaterial, Vector3 } from 'three';
 import { NeuralSky as Network } from './neural_sky.js';
-import { SkyProjector, horizonRule } from './sky_sh.js';
+import { SkyProjector, gaussLegendreUnit, horizonRule, shEval } from './sky_sh.js';
 
 const VERTEX = /* glsl */ `
 varying vec3 vWorldPosition;
@@ -106,6 +106,53 @@ export class NeuralSky extends Mesh {
   }
 }
 
+// k̂_l = 2π ∫_0^1 t^a P_l(t) dt, the zonal factors of the Phong lobe max(t, 0)^a
+// (phong_lobe_zonal() in src/sphere/sh.cpp, which uses Γ functions; here
+// Gauss–Legendre with 64 nodes on [0, 1]).
+export function phongLobeZonal(l, a) {
+  const { nodes, weights } = gaussLegendreUnit(64);
+  let sum = 0;
+  for (let k = 0; k < nodes.length; ++k) {
+    const t = nodes[k];
+    let p0 = 1, p1 = t; // Legendre's recurrence
+    let p = l === 0 ? 1 : t;
+    for (let n = 2; n <= l; ++n) {
+      p = ((2 * n - 1) * t * p1 - (n - 1) * p0) / n;
+      p0 = p1;
+      p1 = p;
+    }
+    sum += weights[k] * Math.pow(t, a) * p;
+  }
+  return 2 * Math.PI * sum;
+}
+
+// The DPRT glossy layer of an SH light as `skybake view` draws it: texel
+// (i, j) of a width × height equirectangular map (row 0 at the zenith, φ from
+// +z towards +x; equirect_direction() in src/render/model_renderer.cpp)
+// holds ∫ L(x) ρ_a(r·x) dμ = Σ_lm (2(a+1)/4π) k̂_l L_lm Y_lm(r) for the mirror
+// direction r at its centre (Funk–Hecke; the normalised Phong lobe ρ_a of
+// skybake/prt.h). RGBA float values, rows in order.
+export function glossyMap(light, exponent, width = 128, height = 64) {
+  const order = light.order;
+  const k = Array.from({ length: order + 1 }, (_, l) => ((2 * (exponent + 1)) / (4 * Math.PI)) * phongLobeZonal(l, exponent));
+  const out = new Float32Array(width * height * 4);
+  const y = new Float64Array((order + 1) * (order + 1));
+  for (let j = 0; j < height; ++j)
+    for (let i = 0; i < width; ++i) {
+      const phi = 2 * Math.PI * ((i + 0.5) / width - 0.5), theta = (Math.PI * (j + 0.5)) / height;
+      shEval(order, Math.sin(theta) * Math.sin(phi), Math.cos(theta), Math.sin(theta) * Math.cos(phi), y);
+      const o = 4 * (j * width + i);
+      for (let l = 0; l <= order; ++l)
+        for (let m = -l; m <= l; ++m) {
+          const idx = l * l + l + m, c = light.coefficients[idx];
+          for (let ch = 0; ch < 3; ++ch) out[o + ch] += k[l] * c[ch] * y[idx];
+        }
+      for (let ch = 0; ch < 3; ++ch) out[o + ch] = Math.max(out[o + ch], 0);
+      out[o + 3] = 1;
+    }
+  return out;
+}
+
 // Adds the sky's SH light to `material` (MeshStandardMaterial,
 // MeshLambertMaterial, ...) through the baked data of the geometry it draws:
 //   mode 'prt': the transfer attributes _prt_0.._prt_{M-1} (three.js's
@@ -114,13 +161,17 @@ export class NeuralSky extends Mesh {
 //   mode 'ao':  the AO attribute `aoAttribute` (default '_ao'; 'color' reads
 //               COLOR_0's red) times the unshadowed SH irradiance, order 2;
 //   mode 'none': no sky light, only the albedo attribute below.
+// glossy: { attribute: '_shading', exponent: 32, specular: 0.25 } adds, with
+// 'prt', the DPRT glossy layer of `skybake view --set shading=dprt`:
+// specular · A · glossyMap(light)(r), A the shading coefficient attribute
+// (a PRT bake's _SHADING), r the view's mirror direction about the normal.
 // albedo: [r, g, b] (linear), or the name of a per-vertex attribute ('_albedo',
 // the lower-cased _ALBEDO of a PRT bake), which then also multiplies the
 // material's colour for three's own lights. The light is added as emissive
 // radiance (albedo × light) so that three's own lights (the sun) keep
 // working. Returns an object whose update(light) takes NeuralSky.shLight()'s
 // result each frame.
-export function skybakeLighting(material, { mode = 'prt', prtGlsl, attributes = 0, order = 3, aoAttribute = '_ao', albedo = [1, 1, 1] } = {}) {
+export function skybakeLighting(material, { mode = 'prt', prtGlsl, attributes = 0, order = 3, aoAttribute = '_ao', albedo = [1, 1, 1], glossy = null } = {}) {
   const count = (order + 1) * (order + 1);
   if (mode === 'ao' && order < 2) throw new Error('skybake: ao lighting needs an SH light of order 2 or more');
   const uniformCount = mode === 'prt' ? count : mode === 'ao' ? 9 : 1;
@@ -137,6 +188,18 @@ export function skybakeLighting(material, { mode = 'prt', prtGlsl, attributes = 
     skybakeLight: { value: Array.from({ length: uniformCount }, () => new Vector3()) },
     skybakeAlbedo: { value: albedoAttribute === null ? new Vector3(...albedo) : new Vector3(1, 1, 1) },
   };
+  const glossyWidth = 128, glossyHeight = 64;
+  if (glossy) {
+    const g = { attribute: '_shading', exponent: 32, specular: 0.25, ...glossy };
+    if (mode !== 'prt') throw new Error("skybake: the glossy layer goes with mode 'prt'");
+    if (!(g.exponent > 0) || !(g.specular >= 0)) throw new Error('skybake: glossy needs an exponent > 0 and a specular ≥ 0');
+    if (!/^[A-Za-z_][A-Za-z0-9_]*$/.test(g.attribute)) throw new Error(`skybake: glossy attribute '${g.attribute}' is not a GLSL name`);
+    glossy = g;
+    const texture = new DataTexture(new Uint16Array(glossyWidth * glossyHeight * 4), glossyWidth, glossyHeight, RGBAFormat, HalfFloatType);
+    Object.assign(texture, { magFilter: LinearFilter, minFilter: LinearFilter, wrapS: RepeatWrapping, wrapT: ClampToEdgeWrapping, generateMipmaps: false });
+    uniforms.skybakeGlossy = { value: texture };
+    uniforms.skybakeSpecular = { value: g.specular };
+  }
   material.onBeforeCompile = (shader) => {
     Object.assign(shader.uniforms, uniforms);
     let decl = `uniform vec3 skybakeLight[${uniformCount}];\nvarying vec3 vSkybakeSky;\nvarying vec3 vSkybakeAlbedo;\n`;
@@ -170,15 +233,30 @@ export function skybakeLighting(material, { mode = 'prt', prtGlsl, attributes = 
         vSkybakeSky = ${albedoValue} / 3.14159265 * max(E, vec3(0.0)) * ${ao}; }`;
     }
     body += `\nvSkybakeAlbedo = ${albedoAttribute === null ? 'vec3(1.0)' : albedoAttribute};`;
+    let fragmentDecl = 'varying vec3 vSkybakeSky;\nvarying vec3 vSkybakeAlbedo;\n';
+    let fragmentBody = 'totalEmissiveRadiance += vSkybakeSky;';
+    if (glossy) {
+      decl += `attribute float ${glossy.attribute};\nvarying float vSkybakeA;\n`;
+      body += `\nvSkybakeA = ${glossy.attribute};`;
+      fragmentDecl += 'varying float vSkybakeA;\nuniform sampler2D skybakeGlossy;\nuniform float skybakeSpecular;\n';
+      // The normal turned towards the eye, the mirror direction in world
+      // space, and the map's equirectangular look-up (sb_equirect_uv()).
+      fragmentBody += `
+      { vec3 skybakeN = normalize(normal), skybakeV = normalize(vViewPosition);
+        if (dot(skybakeN, skybakeV) < 0.0) skybakeN = -skybakeN;
+        vec3 skybakeR = inverseTransformDirection(reflect(-skybakeV, skybakeN), viewMatrix);
+        vec2 skybakeUv = vec2(atan(skybakeR.x, skybakeR.z) * 0.159154943 + 0.5, acos(clamp(skybakeR.y, -1.0, 1.0)) * 0.318309886);
+        totalEmissiveRadiance += skybakeSpecular * vSkybakeA * texture2D(skybakeGlossy, skybakeUv).rgb; }`;
+    }
     shader.vertexShader = decl + shader.vertexShader.replace('#include <begin_vertex>', `#include <begin_vertex>\n${body}`);
     // The per-vertex albedo multiplies the material's colour for three's own
     // lights; the sky's light carries it already.
-    shader.fragmentShader = 'varying vec3 vSkybakeSky;\nvarying vec3 vSkybakeAlbedo;\n' +
+    shader.fragmentShader = fragmentDecl +
       shader.fragmentShader
         .replace('#include <color_fragment>', '#include <color_fragment>\ndiffuseColor.rgb *= vSkybakeAlbedo;')
-        .replace('#include <emissivemap_fragment>', '#include <emissivemap_fragment>\ntotalEmissiveRadiance += vSkybakeSky;');
+        .replace('#include <emissivemap_fragment>', `#include <emissivemap_fragment>\n${fragmentBody}`);
   };
-  material.customProgramCacheKey = () => `skybake-${mode}-${attributes}-${order}-${aoAttribute}-${albedoAttribute}`;
+  material.customProgramCacheKey = () => `skybake-${mode}-${attributes}-${order}-${aoAttribute}-${albedoAttribute}-${glossy ? glossy.attribute : ''}`;
   material.needsUpdate = true;
   return {
     uniforms,
@@ -186,6 +264,12 @@ export function skybakeLighting(material, { mode = 'prt', prtGlsl, attributes = 
       light.coefficients.forEach((c, i) => {
         if (i < uniforms.skybakeLight.value.length) uniforms.skybakeLight.value[i].set(c[0], c[1], c[2]);
       });
+      if (glossy) {
+        const map = glossyMap(light, glossy.exponent, glossyWidth, glossyHeight);
+        const texture = uniforms.skybakeGlossy.value;
+        for (let i = 0; i < map.length; ++i) texture.image.data[i] = DataUtils.toHalfFloat(map[i]);
+        texture.needsUpdate = true;
+      }
     },
   };
 }

@@ -148,7 +148,8 @@ test('skybake web: PRT and AO sites, and their errors', async () => {
 
 // The page against `skybake view --screenshot` of the same model, camera,
 // sun and exposure (one sample per pixel on both sides, no ground: the viewer
-// draws none), at noon, sunset and twilight: PSNR of the 8-bit images.
+// draws none), at noon, sunset and twilight, and with the DPRT glossy layer:
+// PSNR of the 8-bit images.
 test('skybake web matches skybake view (PSNR ≥ 30 dB at three suns)', async () => {
   const engine = join(process.env.SKYBAKE_ASSIMP_MODELS || '/usr/share/assimp/models', 'glTF2', '2CylinderEngine-glTF-Binary', '2CylinderEngine.glb');
   const baked = join(dir, 'engine_prt.glb');
@@ -160,17 +161,19 @@ test('skybake web matches skybake view (PSNR ≥ 30 dB at three suns)', async ()
   const [W, H, view] = [960, 540, '20,8'];
   const { browser, page, errors } = await open('about:blank', [`--window-size=${W},${H}`]);
   await page.setViewport({ width: W, height: H });
+  const means = {}; // name: [viewer, page] mean 8-bit value
   try {
-    for (const [name, elevation, azimuth, ev] of [['noon', 60, 60, 2], ['sunset', 3, 60, 4.5], ['twilight', -4, 60, 10]]) {
-      const png = join(dir, `view_${name}.png`);
+    const suns = [['noon', 60, 60, 2, 'prt'], ['sunset', 3, 60, 4.5, 'prt'], ['twilight', -4, 60, 10, 'prt'], ['sunset, PRT + glossy', 3, 60, 4.5, 'dprt']];
+    for (const [name, elevation, azimuth, ev, shading] of suns) {
+      const png = join(dir, `view_${name.replace(/\W+/g, '_')}.png`);
       r = skybake('view', baked, '--screenshot', png, '--model', weights, '--size', `${W}x${H}`, '--sun-elevation-deg', String(elevation),
-        '--sun-azimuth-deg', String(azimuth), '--set', `view=${view}`, '--set', `exposure=${ev}`, '--set', 'samples=1');
+        '--sun-azimuth-deg', String(azimuth), '--set', `view=${view}`, '--set', `exposure=${ev}`, '--set', 'samples=1', '--set', `shading=${shading}`);
       assert.equal(r.code, 0, r.err);
-      await page.goto(`${pathToFileURL(join(site, 'index.html')).href}?elevation=${elevation}&azimuth=${azimuth}&view=${view}&exposure=${ev}&ground=off&aa=off`);
+      await page.goto(`${pathToFileURL(join(site, 'index.html')).href}?elevation=${elevation}&azimuth=${azimuth}&view=${view}&exposure=${ev}&shading=${shading}&ground=off&aa=off`);
       await page.waitForFunction('(window.skybakeSiteFrames ?? 0) >= 2 || window.skybakeSite?.error', { timeout: 120000 });
       assert.equal(await page.evaluate('window.skybakeSite.error'), undefined);
       const reference = `data:image/png;base64,${readFileSync(png).toString('base64')}`;
-      const { psnr, width, height, mean } = await page.evaluate(async (url) => {
+      const { psnr, width, height, mean, meanGot } = await page.evaluate(async (url) => {
         const img = new Image();
         img.src = url;
         await img.decode();
@@ -180,20 +183,27 @@ test('skybake web matches skybake view (PSNR ≥ 30 dB at three suns)', async ()
         ctx.drawImage(img, 0, 0);
         const ref = ctx.getImageData(0, 0, img.width, img.height).data;
         const got = window.skybakeSite.pixels();
-        let se = 0, sum = 0;
+        let se = 0, sum = 0, sumGot = 0;
         for (let i = 0; i < ref.length; i += 4)
           for (let k = 0; k < 3; ++k) {
             se += (got[i + k] - ref[i + k]) ** 2;
             sum += ref[i + k];
+            sumGot += got[i + k];
           }
         const n = (ref.length / 4) * 3;
-        return { psnr: 10 * Math.log10((255 * 255 * n) / Math.max(se, 1e-9)), width: img.width, height: img.height, mean: sum / n };
+        return { psnr: 10 * Math.log10((255 * 255 * n) / Math.max(se, 1e-9)), width: img.width, height: img.height, mean: sum / n, meanGot: sumGot / n };
       }, reference);
+      means[name] = [mean, meanGot];
       console.log(`${name} (sun ${elevation}°, ${ev} EV): PSNR ${psnr.toFixed(2)} dB against skybake view (mean ${mean.toFixed(1)} of 255)`);
       assert.deepEqual([width, height], [W, H]);
       assert.ok(mean > 8, `the viewer's image is too dark to compare (${mean})`);
       assert.ok(psnr >= 30, `${name}: ${psnr.toFixed(2)} dB`);
     }
+    // The glossy layer is there on both sides, and adds as much light.
+    const viewerGlossy = means['sunset, PRT + glossy'][0] - means.sunset[0], pageGlossy = means['sunset, PRT + glossy'][1] - means.sunset[1];
+    console.log(`the glossy layer adds ${viewerGlossy.toFixed(3)} (viewer) and ${pageGlossy.toFixed(3)} (page) to the mean`);
+    assert.ok(viewerGlossy > 0.2, `viewer ${viewerGlossy}`);
+    assert.ok(Math.abs(pageGlossy / viewerGlossy - 1) < 0.25, `page ${pageGlossy} against viewer ${viewerGlossy}`);
     assert.deepEqual(errors, []);
   } finally {
     await browser.close();
