@@ -8,6 +8,7 @@
 // data.js is a script, not files to fetch, because browsers refuse fetch()
 // on file://. --serve then serves the folder on 127.0.0.1 with Python's
 // http.server (in the foreground; Ctrl-C stops it).
+#include <algorithm>
 #include <unistd.h>
 
 #include <cerrno>
@@ -75,7 +76,20 @@ void add_web(CLI::App& app) {
         std::string shading = "sun only";
         if (!fs::exists(prt_sidecar_path(o->model))) {
             const Mesh mesh = load_mesh(o->model);
-            if (mesh.find_attribute("ao") || !mesh.colors.empty())
+            // The page's order: _AO, COLOR_0, then an occlusion texture (a
+            // material's occlusionTexture, which load_mesh() does not keep)
+            // that the mesh has the UV set for.
+            bool texture_ao = false;
+            if (glb.size() >= 20) {
+                std::uint32_t length = 0;
+                std::memcpy(&length, glb.data() + 12, 4);
+                const auto doc = nlohmann::json::parse(glb.substr(20, length), nullptr, false);
+                if (doc.is_object() && doc.contains("materials") && doc["materials"].is_array())
+                    for (const auto& m : doc["materials"])
+                        if (m.is_object() && m.contains("occlusionTexture") && m["occlusionTexture"].is_object())
+                            texture_ao |= std::size_t(m["occlusionTexture"].value("texCoord", 0)) < mesh.texcoords.size();
+            }
+            if (mesh.find_attribute("ao") || !mesh.colors.empty() || texture_ao)
                 shading = "AO";
         } else {
             shading = "PRT";

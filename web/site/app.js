@@ -151,6 +151,7 @@ async function main() {
   // `skybake view` draws), else the material's colour and image.
   const hooks = [];
   const modes = new Set(['sun']);
+  let aoWithoutUv = false;
   const meshes = [];
   model.traverse((o) => {
     if (!o.isMesh) return;
@@ -162,7 +163,7 @@ async function main() {
     const albedo = perVertex ? '_albedo' : base.toArray();
     const side = o.material?.side;
     // Both faces cast shadows, as in the viewer's depth pass (three's default is the back faces).
-    const make = () => new MeshLambertMaterial({ color: base.clone(), map: o.material?.map ?? null, side, shadowSide: DoubleSide });
+    const make = (extra = {}) => new MeshLambertMaterial({ color: base.clone(), map: o.material?.map ?? null, side, shadowSide: DoubleSide, ...extra });
     const materials = { sun: make() };
     if (perVertex) skybakeLighting(materials.sun, { mode: 'none', albedo }); // the albedo, no sky light
     if (data.prt && a._prt_0) {
@@ -179,10 +180,18 @@ async function main() {
         modes.add('PRT + glossy');
       }
     }
+    const aoMap = o.material?.aoMap ?? null; // glTF's occlusionTexture (`skybake ao --texture`)
+    const aoUv = aoMap && aoMap.channel ? `uv${aoMap.channel}` : 'uv';
     if (a._ao || a.color) {
       materials.AO = make();
       hooks.push(skybakeLighting(materials.AO, { mode: 'ao', aoAttribute: a._ao ? '_ao' : 'color', order: 3, albedo }));
       modes.add('AO');
+    } else if (aoMap && a[aoUv]) {
+      materials.AO = make({ aoMap });
+      hooks.push(skybakeLighting(materials.AO, { mode: 'ao', aoAttribute: 'aoMap', order: 3, albedo }));
+      modes.add('AO');
+    } else if (aoMap) {
+      aoWithoutUv = true;
     }
     meshes.push({ mesh: o, materials });
   });
@@ -195,7 +204,10 @@ async function main() {
     for (const { mesh, materials } of meshes) mesh.material = materials[mode] ?? materials.sun;
   };
   setShading(shading);
-  if (shading === 'sun') say('this model has no baked transfer (_PRT_i) and no AO (_AO or COLOR_0): shown with the sun only', true);
+  if (shading === 'sun')
+    say(aoWithoutUv
+      ? 'this model has an occlusion texture but no UVs to read it with, and no baked transfer (_PRT_i) or AO attribute (_AO, COLOR_0): shown with the sun only'
+      : 'this model has no baked transfer (_PRT_i) and no AO (_AO, COLOR_0 or an occlusion texture): shown with the sun only', true);
   scene.add(model);
 
   // The ground around the model, at the atmosphere's ground albedo, lit by

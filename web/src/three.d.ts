@@ -27,7 +27,7 @@ export interface SkybakeLightingOptions {
   /** Number of _prt_i attributes (the sidecar's "attributes"). */
   attributes?: number;
   order?: number;
-  /** The AO attribute: '_ao' (glTF _AO, lower-cased by GLTFLoader) or 'color' (COLOR_0's red). */
+  /** The AO: '_ao' (glTF _AO, lower-cased by GLTFLoader), 'color' (COLOR_0's red) or 'aoMap' (the material's occlusion texture). */
   aoAttribute?: string;
   /** Linear RGB, or a per-vertex attribute ('_albedo': a PRT bake's _ALBEDO) that also multiplies the material's colour. */
   albedo?: [number, number, number] | string;

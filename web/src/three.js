@@ -159,7 +159,8 @@ export function glossyMap(light, exponent, width = 128, height = 64) {
 //               GLTFLoader lower-cases glTF's _PRT_i) and prtGlsl, the text of
 //               `skybake prt export BAKED.glb --format glsl-es`;
 //   mode 'ao':  the AO attribute `aoAttribute` (default '_ao'; 'color' reads
-//               COLOR_0's red) times the unshadowed SH irradiance, order 2;
+//               COLOR_0's red; 'aoMap' the material's occlusion texture,
+//               per pixel) times the unshadowed SH irradiance, order 2;
 //   mode 'none': no sky light, only the albedo attribute below.
 // glossy: { attribute: '_shading', exponent: 32, specular: 0.25 } adds, with
 // 'prt', the DPRT glossy layer of `skybake view --set shading=dprt`:
@@ -216,11 +217,12 @@ export function skybakeLighting(material, { mode = 'prt', prtGlsl, attributes = 
     } else if (mode === 'none') {
       body = 'vSkybakeSky = vec3(0.0);';
     } else {
-      const ao = aoAttribute === 'color' ? 'color.r' : aoAttribute;
+      // 'aoMap': the material's occlusion texture, read per pixel below.
+      const ao = aoAttribute === 'color' ? 'color.r' : aoAttribute === 'aoMap' ? '1.0' : aoAttribute;
       // COLOR_0 without vertexColors: three declares no `color`, so declare it
       // here (with vertexColors three would also multiply the sun's light by it).
       if (aoAttribute === 'color') decl += '#if !defined(USE_COLOR) && !defined(USE_COLOR_ALPHA)\nattribute vec3 color;\n#endif\n';
-      else decl += `attribute float ${aoAttribute};\n`;
+      else if (aoAttribute !== 'aoMap') decl += `attribute float ${aoAttribute};\n`;
       // Irradiance of an order-2 SH light on the normal (Ramamoorthi & Hanrahan's
       // clamped-cosine factors π, 2π/3, π/4), radiance = albedo/π × E × AO.
       body = `{ vec3 n = normalize(mat3(modelMatrix) * objectNormal);
@@ -234,7 +236,9 @@ export function skybakeLighting(material, { mode = 'prt', prtGlsl, attributes = 
     }
     body += `\nvSkybakeAlbedo = ${albedoAttribute === null ? 'vec3(1.0)' : albedoAttribute};`;
     let fragmentDecl = 'varying vec3 vSkybakeSky;\nvarying vec3 vSkybakeAlbedo;\n';
-    let fragmentBody = 'totalEmissiveRadiance += vSkybakeSky;';
+    let fragmentBody = mode === 'ao' && aoAttribute === 'aoMap'
+      ? '#ifdef USE_AOMAP\ntotalEmissiveRadiance += vSkybakeSky * ((texture2D(aoMap, vAoMapUv).r - 1.0) * aoMapIntensity + 1.0);\n#else\ntotalEmissiveRadiance += vSkybakeSky;\n#endif'
+      : 'totalEmissiveRadiance += vSkybakeSky;';
     if (glossy) {
       decl += `attribute float ${glossy.attribute};\nvarying float vSkybakeA;\n`;
       body += `\nvSkybakeA = ${glossy.attribute};`;

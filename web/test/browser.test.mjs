@@ -68,6 +68,7 @@ test('NeuralSky draws the network of the weights file, and skybakeLighting light
       console.log(`skybakeLighting '${mode}': ${r.got.map((v) => v.toPrecision(6))} against ${r.want.map((v) => v.toPrecision(6))}`);
       assert.ok(r.rel < (mode === 'prt' ? 1e-5 : 2e-4), `${mode}: relative difference ${r.rel}`);
     }
+    assert.deepEqual(Object.keys(lit), ['prt', 'ao', 'ao-texture']);
     for (const r of results) {
       console.log(`${r.name}: ${r.compared} channel values, max relative difference ${r.maxRel.toExponential(2)} from the JS forward pass; ` +
         `view directions within ${r.dirMaxErr.toExponential(1)} of the pixel centres' rays; exp2 within ${r.exp2MaxRel.toExponential(1)}`);

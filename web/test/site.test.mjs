@@ -209,3 +209,60 @@ test('skybake web matches skybake view (PSNR ≥ 30 dB at three suns)', async ()
     await browser.close();
   }
 });
+
+// A .glb whose JSON chunk `edit` changed (the BIN chunk kept).
+function editGlb(input, output, edit) {
+  const b = readFileSync(input);
+  const jsonLength = b.readUInt32LE(12);
+  const doc = JSON.parse(b.subarray(20, 20 + jsonLength).toString('utf8'));
+  edit(doc);
+  let text = JSON.stringify(doc);
+  while (text.length % 4) text += ' ';
+  const json = Buffer.from(text, 'utf8'), rest = b.subarray(20 + jsonLength);
+  const head = Buffer.alloc(20);
+  head.writeUInt32LE(0x46546c67, 0);
+  head.writeUInt32LE(2, 4);
+  head.writeUInt32LE(20 + json.length + rest.length, 8);
+  head.writeUInt32LE(json.length, 12);
+  head.writeUInt32LE(0x4e4f534a, 16);
+  writeFileSync(output, Buffer.concat([head, json, rest]));
+}
+
+// AO that only an occlusion texture carries (as other tools write it): the
+// page lights the model through it; without UVs to read it, the page says so.
+// Blender's Suzanne with `skybake ao --texture`, her _AO and COLOR_0 removed.
+test('skybake web reads AO from an occlusion texture, and says when there are no UVs', async (t) => {
+  const suzanne = join(dir, 'suzanne.glb');
+  const made = spawnSync('blender', ['-b', '--factory-startup', '--python', join(process.env.SKYBAKE_TEST_DATA, 'blender', 'make_suzanne.py'), '--', suzanne, 'material']);
+  if (made.status !== 0) return t.skip('no blender (scripts/install-deps.sh installs it)');
+  const baked = join(dir, 'suzanne_ao.glb');
+  assert.equal(skybake('ao', suzanne, '--rule', 'lebedev:86', '--texture', '64', '-o', baked).code, 0);
+  const drop = (names) => (doc) => doc.meshes.forEach((m) => m.primitives.forEach((p) => names.forEach((n) => delete p.attributes[n])));
+  editGlb(baked, join(dir, 'suzanne_tex.glb'), drop(['_AO', 'COLOR_0']));
+  editGlb(baked, join(dir, 'suzanne_nouv.glb'), drop(['_AO', 'COLOR_0', 'TEXCOORD_0']));
+  for (const [name, shading, message] of [['suzanne_tex', 'AO', null], ['suzanne_nouv', 'sun', /occlusion texture but no UVs/]]) {
+    const site = join(dir, `site_${name}`);
+    const r = skybake('web', join(dir, `${name}.glb`), '--model', weights, '-o', site);
+    assert.equal(r.code, 0, r.err);
+    assert.match(r.out + r.err, new RegExp(`\\(${shading === 'sun' ? 'sun only' : shading} shading`)); // the command names what the page uses
+    const { browser, page, errors } = await open(`${pathToFileURL(join(site, 'index.html')).href}?elevation=30&azimuth=40`);
+    try {
+      await page.waitForFunction('(window.skybakeSiteFrames ?? 0) >= 3 || window.skybakeSite?.error', { timeout: 120000 });
+      assert.equal(await page.evaluate('window.skybakeSite.error'), undefined);
+      assert.equal(await page.evaluate('window.skybakeSite.shading'), shading);
+      const model = await regionMean(page, 0.4, 0.4, 0.6, 0.6);
+      console.log(`${name}: ${shading} shading, model ${model.map((v) => v.toFixed(0))}`);
+      assert.ok(Math.max(...model) > 25, `model ${model}`);
+      const text = await page.evaluate(() => document.getElementById('message').textContent);
+      if (message) {
+        assert.match(text, message);
+        assert.ok(errors.some((e) => message.test(e)), `the console says it too: ${errors}`);
+      } else {
+        assert.equal(text, '');
+        assert.deepEqual(errors, []);
+      }
+    } finally {
+      await browser.close();
+    }
+  }
+});

@@ -2,7 +2,7 @@
 // a float render target through the exported GLSL ES network and compares
 // every pixel with the JavaScript forward pass of the same weights file, on
 // the view direction that pixel's fragment computed (drawn by a second pass).
-import { BufferAttribute, BufferGeometry, FloatType, Mesh, MeshLambertMaterial, OrthographicCamera, PlaneGeometry, ShaderMaterial, PerspectiveCamera, RGBAFormat, Scene, Vector3, WebGLRenderer, WebGLRenderTarget } from 'three';
+import { BufferAttribute, BufferGeometry, DataTexture, FloatType, Mesh, MeshLambertMaterial, OrthographicCamera, PlaneGeometry, ShaderMaterial, PerspectiveCamera, RGBAFormat, Scene, Vector3, WebGLRenderer, WebGLRenderTarget } from 'three';
 import { NeuralSky as Network } from '../../src/neural_sky.js';
 import { shEval } from '../../src/sky_sh.js';
 import { NeuralSky, skybakeLighting } from '../../src/three.js';
@@ -120,7 +120,7 @@ function lighting({ weights, glsl }) {
   const nl = Math.hypot(...normal);
   const n = normal.map((v) => v / nl);
   const out = {};
-  for (const mode of ['prt', 'ao']) {
+  for (const mode of ['prt', 'ao', 'ao-texture']) {
     const g = new BufferGeometry();
     g.setAttribute('position', new BufferAttribute(new Float32Array([-3, -3, 0, 3, -3, 0, 0, 3, 0]), 3));
     g.setAttribute('normal', new BufferAttribute(new Float32Array([...n, ...n, ...n]), 3));
@@ -129,7 +129,15 @@ function lighting({ weights, glsl }) {
       g.setAttribute(`_prt_${a}`, new BufferAttribute(new Float32Array([0, 1, 2].flatMap(() => t.slice(4 * a, 4 * a + 4))), 4));
     g.setAttribute('_ao', new BufferAttribute(new Float32Array([0.625, 0.625, 0.625]), 1));
     const material = new MeshLambertMaterial({ color: 0x000000 });
-    const hook = skybakeLighting(material, mode === 'prt' ? { mode, prtGlsl, attributes: 4, order: 3, albedo } : { mode, order: 3, albedo });
+    if (mode === 'ao-texture') {
+      // The AO in a texture (glTF's occlusionTexture, three's aoMap) instead of an attribute.
+      g.setAttribute('uv', new BufferAttribute(new Float32Array([0.5, 0.5, 0.5, 0.5, 0.5, 0.5]), 2));
+      material.aoMap = new DataTexture(new Float32Array([0.625, 0, 0, 1]), 1, 1, RGBAFormat, FloatType);
+      material.aoMap.needsUpdate = true;
+    }
+    const options = mode === 'prt' ? { mode, prtGlsl, attributes: 4, order: 3, albedo }
+      : { mode: 'ao', order: 3, albedo, aoAttribute: mode === 'ao' ? '_ao' : 'aoMap' };
+    const hook = skybakeLighting(material, options);
     hook.update(light);
     const scene = new Scene();
     scene.add(new Mesh(g, material));
