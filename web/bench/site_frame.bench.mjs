@@ -1,7 +1,8 @@
 // Frame time of a `skybake web` site in headless Chromium (WebGL 2 on
-// SwiftShader unless --gpu), PRT shading with the network behind the model
-// against its baseline in the same page run: the same model lit by the sun
-// alone (the 'sun' shading: no sky light, same sky, same shadow map).
+// SwiftShader), PRT shading with the network behind the model (and PRT +
+// glossy, and the sun alone) against its baseline in the same page run: the
+// same model drawn flat in one colour ('flat': no light, no shadow map, the
+// same network background), measured first and last.
 //   node web/bench/site_frame.bench.mjs SITE/index.html [WIDTHxHEIGHT] [seconds]
 import { pathToFileURL } from 'node:url';
 import { resolve } from 'node:path';
@@ -23,7 +24,7 @@ await page.setViewport({ width, height });
 await page.goto(`${pathToFileURL(resolve(site)).href}?elevation=20&azimuth=135`);
 await page.waitForFunction('(window.skybakeSiteFrames ?? 0) >= 3 || window.skybakeSite?.error', { timeout: 300000 });
 const frameTime = async (mode) => {
-  await page.select('#shading', mode);
+  await page.evaluate((m) => window.skybakeSite.setShading(m), mode);
   await new Promise((r) => setTimeout(r, 1500)); // compile, settle
   const f0 = await page.evaluate('window.skybakeSiteFrames');
   const t0 = Date.now();
@@ -31,8 +32,13 @@ const frameTime = async (mode) => {
   const frames = (await page.evaluate('window.skybakeSiteFrames')) - f0;
   return (Date.now() - t0) / Math.max(1, frames);
 };
-const base = await frameTime('sun');
+const base = await frameTime('flat');
 const prt = await frameTime('PRT');
-const base2 = await frameTime('sun');
-console.log(`${width}x${height}: sun only (baseline) ${base.toFixed(0)} / ${base2.toFixed(0)} ms per frame, PRT + network sky ${prt.toFixed(0)} ms (${(prt / ((base + base2) / 2)).toFixed(2)} x the baseline)`);
+const glossy = await frameTime('PRT + glossy');
+const sun = await frameTime('sun');
+const base2 = await frameTime('flat');
+const mean = (base + base2) / 2;
+console.log(`${width}x${height}: flat (baseline) ${base.toFixed(0)} / ${base2.toFixed(0)} ms per frame; ` +
+  `PRT + network sky ${prt.toFixed(0)} ms (${(prt / mean).toFixed(2)} x), PRT + glossy ${glossy.toFixed(0)} ms (${(glossy / mean).toFixed(2)} x), ` +
+  `sun only ${sun.toFixed(0)} ms (${(sun / mean).toFixed(2)} x)`);
 await browser.close();

@@ -12,6 +12,7 @@ import {
   DirectionalLight,
   DoubleSide,
   Mesh,
+  MeshBasicMaterial,
   MeshLambertMaterial,
   PlaneGeometry,
   PCFSoftShadowMap,
@@ -164,7 +165,8 @@ async function main() {
     const side = o.material?.side;
     // Both faces cast shadows, as in the viewer's depth pass (three's default is the back faces).
     const make = (extra = {}) => new MeshLambertMaterial({ color: base.clone(), map: o.material?.map ?? null, side, shadowSide: DoubleSide, ...extra });
-    const materials = { sun: make() };
+    // 'flat': one constant colour, the benchmarks' baseline (as the viewer's FLAT pass); not in the panel.
+    const materials = { sun: make(), flat: new MeshBasicMaterial({ color: 0x808080 }) };
     if (perVertex) skybakeLighting(materials.sun, { mode: 'none', albedo }); // the albedo, no sky light
     if (data.prt && a._prt_0) {
       materials.PRT = make();
@@ -200,7 +202,9 @@ async function main() {
   if (params.has('shading') && !asked) throw new Error(`?shading=${params.get('shading')} is not prt, dprt, ao or sun`);
   if (asked && !modes.has(asked)) throw new Error(`?shading=${params.get('shading')}: this model has no data for it`);
   const shading = asked ?? (modes.has('PRT') ? 'PRT' : modes.has('AO') ? 'AO' : 'sun');
+  let currentShading = null;
   const setShading = (mode) => {
+    currentShading = mode;
     for (const { mesh, materials } of meshes) mesh.material = materials[mode] ?? materials.sun;
   };
   setShading(shading);
@@ -318,6 +322,7 @@ async function main() {
     }
     const elevation = Math.max(-20, Math.min(90, state.elevation));
     sky.setSun(elevation, state.azimuth);
+    sun.castShadow = currentShading !== 'flat'; // the flat baseline draws the model alone
     const s = sky.material.uniforms.sunPosition.value;
     sun.position.copy(centre).addScaledVector(s, 2 * radius);
     const key = `${elevation.toFixed(2)} ${state.azimuth.toFixed(2)}`;
@@ -375,7 +380,8 @@ async function main() {
     for (let y = 0; y < H; ++y) out.set(px.subarray((H - 1 - y) * W * 4, (H - y) * W * 4), y * W * 4);
     return Array.from(out);
   };
-  window.skybakeSite = { shading, regionMean, pixels };
+  // setShading(mode): 'PRT', 'PRT + glossy', 'AO', 'sun' or 'flat'.
+  window.skybakeSite = { shading, regionMean, pixels, setShading };
 }
 
 main().catch((e) => {
