@@ -3,6 +3,8 @@
 // differences of an independent double-precision implementation, encoding,
 // inference paths, training (loss decrease, determinism), the weights file.
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -11,6 +13,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "core/random.h"
 #include "neural/internal.h"
 #include "sky/device.h"
 #include "skybake/core.h"
@@ -871,4 +874,47 @@ TEST(ImagePsnr, IsTheClosedFormAndANaNPixelIsTheLargestError) {
     EXPECT_NEAR(image_psnr_db(a, b, tm), 10 * std::log10(4.0), 1e-9); // was 999 dB: NaN compared false
     b.pixel(1, 1)[0] = b.pixel(1, 1)[1] = b.pixel(1, 1)[2] = std::numeric_limits<float>::infinity();
     EXPECT_NEAR(image_psnr_db(a, b, tm), 10 * std::log10(4.0), 1e-9); // counted as 1 per channel, not clamped
+}
+
+// Shared test vectors (tests/data/neural/test_vectors.json): inputs and the
+// radiance of the library's scalar pass (neural_sky_radiance(), the order
+// the exported shaders and the JavaScript of web/ follow) for the committed
+// networks. The JavaScript test (web/test/neural_sky.test.mjs) reads the
+// same file. SKYBAKE_WRITE_TEST_VECTORS=1 writes it again.
+TEST(NeuralSky, SharedTestVectorsAreTheScalarPass) {
+    const std::filesystem::path file = std::filesystem::path(SKYBAKE_SOURCE_DIR) / "tests/data/neural/test_vectors.json";
+    const char* networks[] = {"v1_paper.json", "v1_shared_linear.json", "v3_earth_default.json"};
+    if (const char* w = std::getenv("SKYBAKE_WRITE_TEST_VECTORS"); w && std::string(w) == "1") {
+        nlohmann::ordered_json out = {{"format", "skybake-neural-test-vectors"}, {"version", 1},
+                                      {"columns", {"cos_view_zenith", "cos_view_sun", "cos_sun_zenith", "density", "r", "g", "b"}}};
+        for (const char* name : networks) {
+            const NeuralSky net = load_neural_sky(std::filesystem::path(SKYBAKE_SOURCE_DIR) / "tests/data/neural" / name);
+            SplitMix64 rng{0x5eed0000u + std::uint64_t(std::strlen(name))};
+            nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+            while (rows.size() < 500) {
+                const float a = float(2 * rng.uniform() - 1), b = float(2 * rng.uniform() - 1), c = float(2 * rng.uniform() - 1);
+                // A quarter in the flight's thin air (density down to 1e-3).
+                const float rho = rows.size() % 4 == 0 ? float(std::exp(-7 * rng.uniform())) : float(1 - rng.uniform());
+                if (cosine_triple_determinant(a, b, c) < 1e-6 || !(rho > 0.0f))
+                    continue;
+                const glm::vec3 L = neural_sky_radiance(net, {a, b, c, rho});
+                rows.push_back({a, b, c, rho, L.x, L.y, L.z});
+            }
+            out["networks"][name] = rows;
+        }
+        std::ofstream(file) << out.dump() << "\n";
+    }
+    const nlohmann::json doc = nlohmann::json::parse(std::ifstream(file));
+    for (const char* name : networks) {
+        const NeuralSky net = load_neural_sky(std::filesystem::path(SKYBAKE_SOURCE_DIR) / "tests/data/neural" / name);
+        const auto& rows = doc["networks"][name];
+        ASSERT_EQ(rows.size(), 500u) << name;
+        for (const auto& r : rows) {
+            const SkySample s{r[0].get<float>(), r[1].get<float>(), r[2].get<float>(), r[3].get<float>()};
+            const glm::vec3 want(r[4].get<float>(), r[5].get<float>(), r[6].get<float>());
+            const glm::vec3 got = neural_sky_radiance(net, s);
+            // The file holds floats to the last bit (nlohmann writes the shortest round trip).
+            EXPECT_LE(glm::length(got - want), 1e-6f * glm::length(want)) << name;
+        }
+    }
 }

@@ -6,6 +6,9 @@
 // ulps of the encoded outputs; log decoding multiplies those by about 15. So
 // the bound is 2e-5: measured, 4.2e-6 (paper), 4.0e-7 (linear brightness),
 // 1.1e-5 (the default network).
+// The shared test vectors (tests/data/neural/test_vectors.json, which the
+// C++ test NeuralSky.SharedTestVectorsAreTheScalarPass checks against the
+// library's scalar pass) are the tighter check: within 1e-5 relative.
 // Needs SKYBAKE_CLI (the skybake executable) and SKYBAKE_TEST_DATA (the
 // repository's tests/data); ctest's web.neural_sky sets both.
 import { test } from 'node:test';
@@ -86,4 +89,27 @@ test('a file that is not a weights file is one clear error', () => {
   const broken = { format: 'skybake-neural-sky', topology: { kind: 'shared', hidden: [4] }, encoding: { max_n: 1, log_range: 13 },
     atmosphere: { planet_radius_km: 6360, top_radius_km: 6420 }, weights: [[1, 2, 3]] };
   assert.throws(() => new NeuralSky(broken), /each sub-network has 40 weights/);
+});
+
+test('the shared test vectors: the library\'s scalar pass to 1e-5 relative', { skip: !data ? 'SKYBAKE_TEST_DATA not set' : false }, () => {
+  const doc = JSON.parse(readFileSync(join(data, 'neural', 'test_vectors.json'), 'utf8'));
+  assert.equal(doc.format, 'skybake-neural-test-vectors');
+  for (const [file, rows] of Object.entries(doc.networks)) {
+    const sky = new NeuralSky(readFileSync(join(data, 'neural', file), 'utf8'));
+    let worst = 0, lit = 0;
+    for (const r of rows) {
+      const got = sky.radiance(r[0], r[1], r[2], r[3]);
+      const n = Math.hypot(r[4], r[5], r[6]);
+      const d = Math.hypot(got[0] - r[4], got[1] - r[5], got[2] - r[6]);
+      if (n === 0) {
+        assert.ok(d <= 1e-6 * sky.maxN, `${file}: night sample ${r}: ${got}`);
+        continue;
+      }
+      ++lit;
+      worst = Math.max(worst, d / n);
+    }
+    console.log(`${file}: max relative error ${worst.toExponential(2)} against the scalar pass over ${lit} lit vectors`);
+    assert.ok(lit > 100, `${file}: ${lit} lit vectors`);
+    assert.ok(worst < 1e-5, `${file}: worst relative error ${worst}`);
+  }
 });
