@@ -174,7 +174,7 @@ void run(const AoOptions& o, const CLI::App& sub, bool job) {
     const TraceMethod method = choice.method;
     const std::uint32_t resolution = !choice.backend->resolution  ? 0
                                      : o.resolution                ? o.resolution
-                                     : method == TraceMethod::Cube ? kRasterCubeResolution
+                                     : method == TraceMethod::Cube ? raster_cube_resolution(bake.rule.size())
                                                                    : kRasterDirectionalResolution;
 
     // A glTF 2.0 input written as glTF is baked in place: the output is the
@@ -479,7 +479,8 @@ void add_ao_bake(CLI::App& group) {
                     "seed's naive method) or per-polygon (every triangle, cached in shared memory); raster: cube "
                     "(default: a depth cube map per vertex, the seed's) or directional (a depth map per direction)");
     sub->add_option("--resolution", o->resolution,
-                    "raster: cube face or depth map size in texels (default 256 for cube, 2048 for directional)")
+                    "raster: cube face or depth map size in texels (default: cube, from the rule's spacing, 32 for "
+                    "lebedev:590; directional, 2048)")
         ->check(CLI::Range(8u, kRasterMaxResolution));
     sub->add_option("--max-distance", o->max_distance,
                     "Ignore occluders further than this, in mesh units (default: unlimited)")

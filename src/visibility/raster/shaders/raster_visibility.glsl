@@ -29,20 +29,28 @@ layout(std430, binding = 1) readonly buffer Eyes { vec4 u_eye[]; };
 #define v_rel g_rel
 #endif
 layout(location = 0) in vec3 a_position;
+#if defined(SKYBAKE_CUBE)
+// One indirect draw per layer, of the triangles binned to it: its
+// baseInstance selects the layer id (divisor 1).
+layout(location = 1) in int a_layer;
+#define SB_LAYER a_layer
+#else
+#define SB_LAYER gl_InstanceID
+#endif
 out vec3 v_rel;
 flat out int v_layer;
 void main() {
-    v_layer = gl_InstanceID;
+    v_layer = SB_LAYER;
 #if defined(SKYBAKE_VS_LAYER)
-    gl_Layer = gl_InstanceID;
+    gl_Layer = SB_LAYER;
 #endif
-    const vec4 e = u_eye[gl_InstanceID];
+    const vec4 e = u_eye[SB_LAYER];
 #if defined(SKYBAKE_CUBE)
     v_rel = a_position - e.xyz; // relative to the ray origin: no cancellation far from the world origin
-    gl_Position = u_view[gl_InstanceID] * vec4(v_rel, 1.0);
+    gl_Position = u_view[SB_LAYER] * vec4(v_rel, 1.0);
 #else
     v_rel = a_position;
-    gl_Position = u_view[gl_InstanceID] * vec4(a_position, 1.0);
+    gl_Position = u_view[SB_LAYER] * vec4(a_position, 1.0);
 #endif
 }
 #endif
@@ -137,7 +145,7 @@ void main() {
     const int j0 = max(32 * w, u_first_point), j1 = min(32 * w + 32, u_last_point);
     const int slot = (u_first + v) * u_words_per_vertex + w;
     uint bits = 0u;
-    uint edge = 0u; // directional: the four texels disagree (a blocker's edge), left to the CPU tracer
+    uint edge = 0u; // the four texels disagree (a blocker's edge): left to the CPU tracer
     for (int j = j0; j < j1; ++j) {
         vec3 x = u_points[j].xyz;
 #if defined(SKYBAKE_CUBE)
@@ -148,9 +156,32 @@ void main() {
         const int face = l.z >= max(ax, ay) ? 0 : ax >= ay ? (l.x > 0.0 ? 1 : 2) : (l.y > 0.0 ? 3 : 4);
         const int layer = 5 * v + face;
         const vec4 clip = u_view[layer] * vec4(x, 0.0);
-        const float depth = texelFetch(u_depth, ivec3(texel_of(clip.xy / clip.w), layer), 0).r;
-        if (depth < 1.0 && depth * u_far <= u_t_max)
+        const vec2 ndc = clip.xy / clip.w;
+        const float depth = texelFetch(u_depth, ivec3(texel_of(ndc), layer), 0).r;
+        const bool hit = depth < 1.0 && depth * u_far <= u_t_max;
+        if (hit)
             bits |= 1u << uint(j & 31);
+        // The texel's centre stands for the direction: where the four texels
+        // around the direction disagree, a blocker's edge passes within a
+        // texel of it, and the CPU tracer answers instead (answer_edges); so
+        // it does along the face's border.
+        const vec2 f = (ndc * 0.5 + 0.5) * float(u_resolution) - 0.5;
+        const ivec2 i0 = ivec2(floor(f));
+        bool any_hit = false, any_open = false;
+        for (int dy = 0; dy < 2; ++dy)
+            for (int dx = 0; dx < 2; ++dx) {
+                const ivec2 t = clamp(i0 + ivec2(dx, dy), ivec2(0), ivec2(u_resolution - 1));
+                const float d = texelFetch(u_depth, ivec3(t, layer), 0).r;
+                const bool h = d < 1.0 && d * u_far <= u_t_max;
+                any_hit = any_hit || h;
+                any_open = any_open || !h;
+            }
+        // Within half a texel of the face's border (where Lebedev rules put
+        // whole rings of directions, for an axis-aligned normal) the four
+        // texels are clamped to this face and cannot see the next one.
+        const bool border = any(lessThan(i0, ivec2(0))) || any(greaterThan(i0 + 1, ivec2(u_resolution - 1)));
+        if ((any_hit && any_open) || border)
+            edge |= 1u << uint(j & 31);
 #else
         const int layer = j - u_first_point;
         // Normal offset (docs/baking.md): the look-up point is 2.1 texels
@@ -189,6 +220,7 @@ void main() {
     }
 #if defined(SKYBAKE_CUBE)
     u_words[slot] = bits;
+    u_words[u_edge_offset + slot] = edge;
 #else
     u_words[slot] = (u_first_point > 32 * w ? u_words[slot] : 0u) | bits;
     u_words[u_edge_offset + slot] = (u_first_point > 32 * w ? u_words[u_edge_offset + slot] : 0u) | edge;
