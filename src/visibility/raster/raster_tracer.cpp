@@ -151,6 +151,16 @@ void bin_cube_faces(const std::vector<glm::vec3>& positions, const std::vector<s
     }
 }
 
+// Traces `rays` and sets bit which[q] of `words` where ray q is blocked.
+void trace_into(const RayQueries& queries, const std::vector<Ray>& rays, const std::vector<std::uint32_t>& which,
+                std::vector<std::uint8_t>& hit, std::uint32_t* words) {
+    hit.resize(rays.size());
+    queries.occluded(rays, hit);
+    for (std::size_t q = 0; q < rays.size(); ++q)
+        if (hit[q])
+            set_bit(words, which[q]);
+}
+
 // glMultiDrawElementsIndirect's command (OpenGL 4.6, section 10.4).
 struct DrawElementsCommand {
     GLuint count, instance_count, first_index;
@@ -626,11 +636,7 @@ void RasterTracer::answer_near_field(const TraceChunk& chunk, std::vector<std::u
                 rays.push_back(r);
                 which.push_back(j);
             }
-            hit.resize(rays.size());
-            near.occluded(rays, hit);
-            for (std::size_t q = 0; q < rays.size(); ++q)
-                if (hit[q])
-                    set_bit(mine, which[q]);
+            trace_into(near, rays, which, hit, mine);
         }
     });
 }
@@ -672,11 +678,7 @@ void RasterTracer::answer_edges(const TraceChunk& chunk, std::vector<std::uint32
                 rays.push_back(ray);
                 which.push_back(j);
             }
-            hit.resize(rays.size());
-            near.occluded(rays, hit);
-            for (std::size_t q = 0; q < rays.size(); ++q)
-                if (hit[q])
-                    set_bit(mine, which[q]);
+            trace_into(near, rays, which, hit, mine);
             counts[i] = rays.size();
         }
     });
