@@ -788,9 +788,10 @@ void RasterTracer::trace_cube(const TraceChunk& chunk) {
             }
         });
         std::vector<std::size_t> at(lists.size() + 1, 0);
-        commands.resize(lists.size());
+        commands.clear();
         for (std::size_t layer = 0; layer < lists.size(); ++layer) {
-            commands[layer] = {GLuint(3 * lists[layer].size()), 1, GLuint(at[layer]), 0, GLuint(layer)};
+            if (!lists[layer].empty()) // an empty face stays cleared: no draw (each costs, even empty)
+                commands.push_back({GLuint(3 * lists[layer].size()), 1, GLuint(at[layer]), 0, GLuint(layer)});
             at[layer + 1] = at[layer] + 3 * lists[layer].size();
         }
         const std::size_t total = at.back();
