@@ -266,3 +266,24 @@ test('skybake web reads AO from an occlusion texture, and says when there are no
     }
   }
 });
+
+// A URL setting out of range, or a shading the model has no data for: one
+// message on the page and in the console, not a blank canvas.
+test('skybake web: a bad URL setting is a message on the page', async () => {
+  const city = join(dir, 'city_url.glb'), baked = join(dir, 'city_url_ao.glb'), site = join(dir, 'site_url');
+  assert.equal(skybake('mesh', 'generate', '--kind', 'city', '--triangles', '500', '--seed', '1', '-o', city).code, 0);
+  assert.equal(skybake('ao', city, '--rule', 'lebedev:50', '-o', baked).code, 0);
+  assert.equal(skybake('web', baked, '--model', weights, '-o', site).code, 0);
+  for (const [query, want] of [['elevation=95', /elevation=95 is not a number in \[-20, 90\]/], ['view=10', /view=10 is not AZIMUTH,ELEVATION/],
+    ['shading=prt', /shading=prt: this model has no data for it/], ['shading=glossy', /shading=glossy is not prt, dprt, ao or sun/]]) {
+    const { browser, page, errors } = await open(`${pathToFileURL(join(site, 'index.html')).href}?${query}`);
+    try {
+      await page.waitForFunction('window.skybakeSite?.error', { timeout: 60000 });
+      const text = await page.evaluate(() => document.getElementById('message').textContent);
+      assert.match(text, want);
+      assert.ok(errors.some((e) => want.test(e)), `the console says it too: ${errors}`);
+    } finally {
+      await browser.close();
+    }
+  }
+});
