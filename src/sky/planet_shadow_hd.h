@@ -28,27 +28,29 @@ struct ShadowInterval {
     Real t0, t1;
 };
 
+// Narrows [lo, hi] to where c + k t < 0; false where that is nowhere.
+template <class Real>
+SKYBAKE_HD_INLINE bool narrow_to_negative(Real c, Real k, Real& lo, Real& hi) {
+    if (k > Real(0))
+        hi = fmin(hi, -c / k);
+    else if (k < Real(0))
+        lo = fmax(lo, -c / k);
+    else
+        return c < Real(0);
+    return true;
+}
+
 template <class Real>
 SKYBAKE_HD_INLINE ShadowInterval<Real> planet_shadow_interval(Real r, Real R, Real mu, Real nu, Real mu_s) {
-    const Real inf = Real(INFINITY);
-    Real lo = Real(0), hi = inf;
+    Real lo = Real(0), hi = Real(INFINITY);
     // Behind the terminator plane: r μs + t ν < 0.
-    const Real a0 = r * mu_s;
-    if (nu > Real(0))
-        hi = fmin(hi, -a0 / nu);
-    else if (nu < Real(0))
-        lo = fmax(lo, -a0 / nu);
-    else if (!(a0 < Real(0)))
+    if (!narrow_to_negative(r * mu_s, nu, lo, hi))
         return {Real(1), Real(0)};
     // Inside the cylinder: A t² + B t + C < 0.
     const Real A = Real(1) - nu * nu, B = Real(2) * r * (mu - mu_s * nu), C = r * r * (Real(1) - mu_s * mu_s) - R * R;
     if (A <= Real(1e-12) * (r * r) / (R * R + r * r)) {
         // Along the sun: the distance to the axis is constant to first order.
-        if (B > Real(0))
-            hi = fmin(hi, -C / B);
-        else if (B < Real(0))
-            lo = fmax(lo, -C / B);
-        else if (!(C < Real(0)))
+        if (!narrow_to_negative(C, B, lo, hi))
             return {Real(1), Real(0)};
     } else {
         const Real D = B * B - Real(4) * A * C;

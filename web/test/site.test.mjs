@@ -38,6 +38,20 @@ async function open(url, extraArgs = []) {
   return { browser, page, errors };
 }
 
+// The page at `url` fails with a message matching `want`, on the page and in
+// the console, rather than a blank canvas.
+async function expectPageError(url, want, extraArgs = []) {
+  const { browser, page, errors } = await open(url, extraArgs);
+  try {
+    await page.waitForFunction('window.skybakeSite?.error', { timeout: 60000 });
+    const text = await page.evaluate(() => document.getElementById('message').textContent);
+    assert.match(text, want);
+    assert.ok(errors.some((e) => want.test(e)), `the console says it too: ${errors}`);
+  } finally {
+    await browser.close();
+  }
+}
+
 // Mean RGB (0–255) of the view over a rectangle in fractions of its size.
 const regionMean = (page, ...r) => page.evaluate((r) => window.skybakeSite.regionMean(...r), r);
 
@@ -134,15 +148,7 @@ test('skybake web: PRT and AO sites, and their errors', async () => {
   rmSync(join(site, 'data.js'));
   for (const [extra, want] of [[[], /data\.js/], [['--disable-3d-apis'], /WebGL 2/]]) {
     if (extra.length) skybake('web', join(dir, 'city_ao.glb'), '--model', weights, '-o', site);
-    const { browser, page, errors } = await open(pathToFileURL(join(site, 'index.html')).href, extra);
-    try {
-      await page.waitForFunction('window.skybakeSite?.error', { timeout: 60000 });
-      const text = await page.evaluate(() => document.getElementById('message').textContent);
-      assert.match(text, want);
-      assert.ok(errors.some((e) => want.test(e)), `the console says it too: ${errors}`);
-    } finally {
-      await browser.close();
-    }
+    await expectPageError(pathToFileURL(join(site, 'index.html')).href, want, extra);
   }
 });
 
@@ -276,14 +282,6 @@ test('skybake web: a bad URL setting is a message on the page', async () => {
   assert.equal(skybake('web', baked, '--model', weights, '-o', site).code, 0);
   for (const [query, want] of [['elevation=95', /elevation=95 is not a number in \[-20, 90\]/], ['view=10', /view=10 is not AZIMUTH,ELEVATION/],
     ['shading=prt', /shading=prt: this model has no data for it/], ['shading=glossy', /shading=glossy is not prt, dprt, ao or sun/]]) {
-    const { browser, page, errors } = await open(`${pathToFileURL(join(site, 'index.html')).href}?${query}`);
-    try {
-      await page.waitForFunction('window.skybakeSite?.error', { timeout: 60000 });
-      const text = await page.evaluate(() => document.getElementById('message').textContent);
-      assert.match(text, want);
-      assert.ok(errors.some((e) => want.test(e)), `the console says it too: ${errors}`);
-    } finally {
-      await browser.close();
-    }
+    await expectPageError(`${pathToFileURL(join(site, 'index.html')).href}?${query}`, want);
   }
 });
