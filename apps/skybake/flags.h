@@ -13,6 +13,7 @@
 #include <utility>
 
 #include <CLI/CLI.hpp>
+#include <glm/vec3.hpp>
 
 #include "skybake/error.h"
 
@@ -113,5 +114,9 @@ bool given(const CLI::App& sub, const char* flag);
 // (skybake/visibility.h, [SECTION] Backends).
 std::string device_help();
 std::string backend_help();
+
+// "0.8" or "0.8,0.6,0.4": a linear RGB reflectance in [0, 1]. Throws
+// UsageError naming `flag`.
+glm::vec3 parse_albedo(const std::string& text, const char* flag = "--albedo");
 
 } // namespace skybake::cli

@@ -27,33 +27,6 @@ struct BakeOpts {
     bool json = false, mpi = false;
 };
 
-// "0.8" or "0.8,0.6,0.4": a linear RGB reflectance in [0, 1].
-glm::vec3 parse_albedo(const std::string& text) {
-    std::vector<float> v;
-    std::stringstream s(text);
-    std::string part;
-    while (std::getline(s, part, ',')) {
-        std::size_t used = 0;
-        float x = 0.0f;
-        try {
-            x = std::stof(part, &used);
-        } catch (const std::exception&) {
-            used = 0;
-        }
-        if (used != part.size() || part.empty() || !(x >= 0.0f && x <= 1.0f))
-            throw UsageError(fmt::format("albedo '{}' is not a reflectance; give one or three numbers in [0, 1], "
-                                         "e.g. 0.8 or 0.8,0.6,0.4",
-                                         text),
-                             "--albedo");
-        v.push_back(x);
-    }
-    if (v.size() == 1)
-        return glm::vec3(v[0]);
-    if (v.size() == 3)
-        return {v[0], v[1], v[2]};
-    throw UsageError(fmt::format("albedo '{}' needs one or three numbers", text), "--albedo");
-}
-
 void run(const BakeOpts& o, const CLI::App& sub) {
     const bool job = start_job(o.mpi); // first: in a job, every error is reported once
     BakeJob bake;

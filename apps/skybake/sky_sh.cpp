@@ -21,7 +21,7 @@ void add_sky_sh(CLI::App& group) {
     struct Opts {
         AtmosphereFlags atm;
         ModelFlag model;
-        std::string output, gltf, rule = kSkyLightRule, device = "cpu", convention = "skybake";
+        std::string output, gltf, rule = kSkyLightRule, device = "cpu", convention = "skybake", ground;
         int cube_size = 32;
         double elevation = 30.0, azimuth = 0.0, altitude = 0.0;
         int order = 3;
@@ -48,6 +48,9 @@ void add_sky_sh(CLI::App& group) {
                     "Signs of the written coefficients: skybake (no (-1)^m, Ramamoorthi & Hanrahan 2001) or "
                     "condon-shortley ((-1)^m, Sloan 2008 and D3DX: odd-|m| terms negated); the file records it")
         ->capture_default_str();
+    sub->add_option("--ground-albedo", o->ground,
+                    "Light the ground below the horizon: a Lambertian ground of this albedo (A or R,G,B in [0, 1]) "
+                    "lit by the sun and the sky (default: none, only the air's light below the horizon)");
     sub->add_option("--gltf", o->gltf,
                     "A glTF 2.0 document (.glb or .gltf) to write again as -o LIT.glb/.gltf with the sky as an "
                     "EXT_lights_image_based light: order-2 irradiance SH (Babylon.js's basis) and a radiance cube");
@@ -68,6 +71,10 @@ void add_sky_sh(CLI::App& group) {
             throw UsageError("--cube-size is for the light written into a glTF document (--gltf)", "--cube-size");
         if (gltf && sub->count("--order") && o->order != 2)
             throw UsageError("EXT_lights_image_based holds order 2 (9 coefficients); leave --order out", "--order");
+        if (gltf && !o->ground.empty())
+            throw UsageError("--ground-albedo lights the SH light file's lower hemisphere; the glTF light holds the sky "
+                             "alone (its engine draws the ground)",
+                             "--ground-albedo");
         if (gltf && sub->count("--sh-convention"))
             throw UsageError("EXT_lights_image_based fixes its SH convention (Babylon.js's); leave --sh-convention out",
                              "--sh-convention");
@@ -89,6 +96,8 @@ void add_sky_sh(CLI::App& group) {
         s.sun_elevation_deg = o->elevation;
         s.sun_azimuth_deg = o->azimuth;
         s.altitude_km = o->altitude;
+        if (!o->ground.empty())
+            s.ground_albedo = parse_albedo(o->ground, "--ground-albedo");
         if (gltf) {
             GltfAsset doc = parse_flag("--gltf", [&] { return GltfAsset::load(o->gltf); });
             const auto t0 = std::chrono::steady_clock::now();

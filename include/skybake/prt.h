@@ -22,6 +22,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -244,6 +245,16 @@ struct SkyLightSettings {
     double sun_azimuth_deg = 0.0;    // 0: towards +z, 90: towards +x
     double altitude_km = 0.0;        // observer above the ground, ≥ 0
     bool sun = true;                 // fill ShLight::sun_* (the transmitted sun)
+    // The lit ground (off by default: below the horizon only the air's light).
+    // With an albedo ρ (per channel, in [0, 1]), each direction that meets
+    // the ground also gets the light of a Lambertian ground there,
+    //     T(observer ← ground) · ρ/π · (max(s·u_g, 0) T_sun(ground) + E_sky),
+    // u_g the ground point's vertical, T from the optical-length tables and
+    // E_sky the sky's irradiance on a horizontal surface as the projection
+    // sees it from the observer (exact at the ground; an approximation above
+    // it), all per unit sun irradiance as the sky's radiance is. A model
+    // standing on the ground then gets its bounce light.
+    std::optional<glm::vec3> ground_albedo;
 };
 
 // World direction (unit, +y up) of a sun at this elevation and azimuth.
@@ -268,6 +279,8 @@ public:
     int order() const { return order_; }
 
 private:
+    void add_lit_ground(const SkySource& sky, const SkyLightSettings& s, const glm::vec3& sun,
+                        std::vector<glm::vec3>& radiance) const;
     int order_;
     std::vector<glm::vec3> points_;
     std::vector<float> weighted_table_; // 4π w_k Y_i(x_k) at k · coefficients + i

@@ -144,6 +144,8 @@ ShLight SkyProjector::project(const SkySource& sky, const SkyLightSettings& s) c
     std::vector<glm::vec3> radiance(points_.size());
     sky.evaluate(samples, radiance);
     const int nc = sh_count(order_);
+    if (s.ground_albedo)
+        add_lit_ground(sky, s, sun, radiance);
     ShLight l;
     l.order = order_;
     l.coeffs.assign(std::size_t(nc), glm::vec3(0.0f));
@@ -158,6 +160,49 @@ ShLight SkyProjector::project(const SkySource& sky, const SkyLightSettings& s) c
         l.sun_irradiance =
             glm::vec3(sky.atmosphere().sun_irradiance * sun_transmittance(sky.tables(), s.altitude_km, double(sun.y)));
     return l;
+}
+
+// SkyLightSettings::ground_albedo: the light of a Lambertian ground added to
+// the directions that meet it (skybake/prt.h).
+void SkyProjector::add_lit_ground(const SkySource& sky, const SkyLightSettings& s, const glm::vec3& sun,
+                                  std::vector<glm::vec3>& radiance) const {
+    const glm::vec3 albedo = *s.ground_albedo;
+    if (!(glm::all(glm::greaterThanEqual(albedo, glm::vec3(0.0f))) && glm::all(glm::lessThanEqual(albedo, glm::vec3(1.0f)))))
+        throw Error(fmt::format("the ground albedo must be in [0, 1]; got ({}, {}, {})", albedo.x, albedo.y, albedo.z),
+                    "ground_albedo");
+    const Atmosphere& atm = sky.atmosphere();
+    const SkyModel& tables = sky.tables();
+    const int nc = sh_count(order_);
+    // The sky's irradiance on a horizontal surface: Σ 4π w_k L_k max(y_k, 0),
+    // with 4π w_k = (4π w_k Y_00) / Y_00.
+    glm::dvec3 e_sky(0.0);
+    for (std::size_t k = 0; k < points_.size(); ++k)
+        if (points_[k].y > 0.0f)
+            e_sky += glm::dvec3(radiance[k]) * double(weighted_table_[k * std::size_t(nc)]) * (2.0 * std::sqrt(M_PI)) *
+                     double(points_[k].y);
+    const double R = atm.planet_radius_km, r = R + s.altitude_km;
+    const auto tau = [&](double altitude, double cos_zenith) {
+        glm::dvec3 t(0.0);
+        for (int c = 0; c < int(atm.components.size()); ++c)
+            t += atm.components[std::size_t(c)].extinction_per_km * tables.tables().optical_length(c, altitude, cos_zenith);
+        return t;
+    };
+    const glm::dvec3 up(0.0, 1.0, 0.0), sd(sun);
+    for (std::size_t k = 0; k < points_.size(); ++k) {
+        const glm::dvec3 x(points_[k]);
+        const double mu = x.y, disc = r * r * (mu * mu - 1.0) + R * R;
+        if (!(mu < 0.0) || disc < 0.0)
+            continue; // the ray misses the ground
+        const double t = -r * mu - std::sqrt(disc);
+        const glm::dvec3 g = r * up + std::max(t, 0.0) * x, up_g = glm::normalize(g);
+        const double cos_sun_g = glm::dot(up_g, sd);
+        // Back along the ray from the ground: the air between it and the observer.
+        const glm::dvec3 seg = t > 0.0 ? glm::exp(-(tau(0.0, glm::dot(up_g, -x)) - tau(s.altitude_km, -mu)))
+                                       : glm::dvec3(1.0);
+        const glm::dvec3 e = (cos_sun_g > 0.0 ? cos_sun_g * sun_transmittance(tables, 0.0, cos_sun_g) : glm::dvec3(0.0)) +
+                             e_sky;
+        radiance[k] += glm::vec3(seg * glm::dvec3(albedo) * (1.0 / M_PI) * e);
+    }
 }
 
 ShLight sky_light(const SkySource& sky, const SkyLightSettings& settings, int order, const SphereRule& rule) {

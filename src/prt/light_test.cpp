@@ -313,3 +313,64 @@ TEST(ShConvention, ExportedDiffuseNegatesOddMTerms) {
 
 } // namespace
 } // namespace skybake
+
+namespace skybake {
+namespace {
+
+// The lit ground (SkyLightSettings::ground_albedo). From the ground every
+// downward direction meets it at the observer's feet, so it adds a constant
+// L_g = ρ/π (sin e · T_sun + E_sky) below the horizon: ΔL_00 = √π L_g and
+// ΔL_1,-1 (∝ y) = −√(3/4π) π L_g, the other coefficients of order 1 nothing.
+// E_sky comes from a midpoint grid over the upper hemisphere here, not from
+// the projection's rule.
+TEST_F(SkyLight, TheLitGroundAddsItsLambertianLight) {
+    SkyLightSettings s;
+    s.sun_elevation_deg = 40.0;
+    s.sun_azimuth_deg = 25.0;
+    const SphereRule rule = parse_rule(kSkyLightRule);
+    const ShLight off = sky_light(sky(), s, 2, rule);
+    s.ground_albedo = glm::vec3(0.3f, 0.2f, 0.1f);
+    const ShLight on = sky_light(sky(), s, 2, rule);
+    const glm::vec3 sun = sun_direction(s.sun_elevation_deg, s.sun_azimuth_deg);
+    const int nt = 200, np = 400;
+    std::vector<SkySample> samples;
+    std::vector<double> weights;
+    for (int i = 0; i < nt; ++i)
+        for (int j = 0; j < np; ++j) {
+            const double th = (i + 0.5) * (0.5 * M_PI) / nt, ph = (j + 0.5) * 2.0 * M_PI / np;
+            const glm::dvec3 x(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
+            samples.push_back({float(x.y), float(glm::dot(glm::vec3(x), sun)), sun.y, 1.0f});
+            weights.push_back(std::sin(th) * std::cos(th) * (0.5 * M_PI / nt) * (2.0 * M_PI / np));
+        }
+    std::vector<glm::vec3> radiance(samples.size());
+    sky().evaluate(samples, radiance);
+    glm::dvec3 e_sky(0.0);
+    for (std::size_t k = 0; k < samples.size(); ++k)
+        e_sky += weights[k] * glm::dvec3(radiance[k]);
+    const glm::dvec3 t_sun = sun_transmittance(sky().tables(), 0.0, double(sun.y));
+    const glm::dvec3 lg = glm::dvec3(*s.ground_albedo) / M_PI * (double(sun.y) * t_sun + e_sky);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(on.coeffs[0][c] - off.coeffs[0][c], std::sqrt(M_PI) * lg[c], 2e-3 * std::sqrt(M_PI) * lg[c]) << c;
+        EXPECT_NEAR(on.coeffs[1][c] - off.coeffs[1][c], -std::sqrt(3.0 / (4.0 * M_PI)) * M_PI * lg[c],
+                    2e-3 * std::sqrt(M_PI) * lg[c])
+            << c;
+        EXPECT_NEAR(on.coeffs[2][c], off.coeffs[2][c], 1e-6 * std::sqrt(M_PI) * lg[c]) << c;
+        EXPECT_NEAR(on.coeffs[3][c], off.coeffs[3][c], 1e-6 * std::sqrt(M_PI) * lg[c]) << c;
+    }
+    // From 10 km up the ground is further and seen through the air: less of it.
+    SkyLightSettings high = s;
+    high.altitude_km = 10.0;
+    SkyLightSettings high_off = high;
+    high_off.ground_albedo.reset();
+    const double added_high = sky_light(sky(), high, 2, rule).coeffs[0].z - sky_light(sky(), high_off, 2, rule).coeffs[0].z;
+    EXPECT_GT(added_high, 0.0);
+    EXPECT_LT(added_high, on.coeffs[0].z - off.coeffs[0].z);
+    // A black ground adds nothing; an albedo outside [0, 1] is refused.
+    s.ground_albedo = glm::vec3(0.0f);
+    EXPECT_EQ(sky_light(sky(), s, 2, rule).coeffs[0], off.coeffs[0]);
+    s.ground_albedo = glm::vec3(1.5f, 0.2f, 0.2f);
+    EXPECT_THROW(sky_light(sky(), s, 2, rule), Error);
+}
+
+} // namespace
+} // namespace skybake
