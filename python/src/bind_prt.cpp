@@ -125,15 +125,20 @@ void bind_prt(py::module_& m) {
     m.def(
         "sky_light",
         [](const SkySource& sky, double sun_elevation_deg, double sun_azimuth_deg, double altitude_km, bool sun,
-           int order, const std::string& rule_spec) {
+           int order, const std::string& rule_spec, std::optional<std::vector<float>> ground_albedo) {
             const SphereRule rule = parse_rule(rule_spec);
             SkyLightSettings s{sun_elevation_deg, sun_azimuth_deg, altitude_km, sun};
+            if (ground_albedo)
+                s.ground_albedo = ground_albedo->size() == 1 ? glm::vec3((*ground_albedo)[0])
+                                                             : vec3_arg(*ground_albedo, "ground_albedo");
             py::gil_scoped_release release;
             return sky_light(sky, s, order, rule);
         },
         py::arg("sky"), py::arg("sun_elevation_deg") = 30.0, py::arg("sun_azimuth_deg") = 0.0,
         py::arg("altitude_km") = 0.0, py::arg("sun") = true, py::arg("order") = 3, py::arg("rule") = kSkyLightRule,
-        "The sky (+y up; azimuth 0 towards +z, 90 towards +x) projected on SH, with the transmitted sun.");
+        py::arg("ground_albedo") = py::none(),
+        "The sky (+y up; azimuth 0 towards +z, 90 towards +x) projected on SH, with the transmitted sun; "
+        "ground_albedo ([a] or [r, g, b] in [0, 1]) adds the lit ground below the horizon (`sky sh --ground-albedo`).");
     m.def(
         "constant_light",
         [](const std::vector<float>& radiance, int order) {

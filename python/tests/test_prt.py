@@ -29,6 +29,14 @@ def test_sky_light_and_sun(bowl):
     assert min(light.sun_irradiance) > 0
     down = skybake.sky_light(sky, sun_elevation_deg=-30, order=3, rule="lebedev:590")
     assert max(down.sun_irradiance) == 0
+    # The lit ground (as `sky sh --ground-albedo`): brighter below, L_1,-1 (∝ y) lower; refused outside [0, 1].
+    ground = skybake.sky_light(sky, sun_elevation_deg=40, sun_azimuth_deg=90, order=3, rule="lebedev:590",
+                               ground_albedo=[0.3])
+    assert np.all(ground.coeffs[0] > light.coeffs[0]) and np.all(ground.coeffs[1] < light.coeffs[1])
+    with pytest.raises(skybake.Error, match="ground_albedo"):
+        skybake.sky_light(sky, ground_albedo=[1.5])
+    with pytest.raises(skybake.Error, match="ground_albedo"):
+        skybake.sky_light(sky, ground_albedo=[0.1, float("nan"), 0.1])
     m = bowl.copy()
     t = skybake.bake_transfer(m, order=3)
     albedo = np.full((m.vertex_count, 3), 0.5, np.float32)
