@@ -1,5 +1,7 @@
 #include "cli_runner.h"
 
+#include "skybake/gltf_asset.h"
+
 #include <csignal>
 #include <cstdint>
 #include <cstring>
@@ -127,11 +129,7 @@ std::string gltf_json_text(const std::string& path) {
     const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (path.size() >= 5 && path.compare(path.size() - 5, 5, ".gltf") == 0)
         return data;
-    std::uint32_t len = 0;
-    if (data.size() < 20)
-        return {};
-    std::memcpy(&len, data.data() + 12, 4);
-    return data.substr(20, len);
+    return glb_json_chunk(data, path);
 }
 
 } // namespace skybake::test

@@ -80,15 +80,11 @@ void add_web(CLI::App& app) {
             // material's occlusionTexture, which load_mesh() does not keep)
             // that the mesh has the UV set for.
             bool texture_ao = false;
-            if (glb.size() >= 20) {
-                std::uint32_t length = 0;
-                std::memcpy(&length, glb.data() + 12, 4);
-                const auto doc = nlohmann::json::parse(glb.substr(20, length), nullptr, false);
-                if (doc.is_object() && doc.contains("materials") && doc["materials"].is_array())
-                    for (const auto& m : doc["materials"])
-                        if (m.is_object() && m.contains("occlusionTexture") && m["occlusionTexture"].is_object())
-                            texture_ao |= std::size_t(m["occlusionTexture"].value("texCoord", 0)) < mesh.texcoords.size();
-            }
+            const auto doc = nlohmann::json::parse(glb_json_chunk(glb, o->model), nullptr, false);
+            if (doc.is_object() && doc.contains("materials") && doc["materials"].is_array())
+                for (const auto& m : doc["materials"])
+                    if (m.is_object() && m.contains("occlusionTexture") && m["occlusionTexture"].is_object())
+                        texture_ao |= std::size_t(m["occlusionTexture"].value("texCoord", 0)) < mesh.texcoords.size();
             if (mesh.find_attribute("ao") || !mesh.colors.empty() || texture_ao)
                 shading = "AO";
         } else {

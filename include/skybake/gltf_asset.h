@@ -166,6 +166,10 @@ private:
     ImportReport report_;
 };
 
+// The JSON chunk of a GLB file's bytes. Throws skybake::Error naming `where`
+// when there is no 'glTF' magic or no complete JSON chunk.
+std::string glb_json_chunk(const std::string& data, const std::string& where);
+
 // Standard base64 (RFC 4648, with padding) of `bytes`: tinygltf's encoder,
 // the one that writes data: URIs. For embedding a .glb in a web page.
 std::string base64_encode(std::string_view bytes);

@@ -53,16 +53,6 @@ std::uint32_t read_u32(const std::string& data, std::size_t at) {
     return v;
 }
 
-// The JSON chunk of a GLB file (the file is checked by check_gltf() first).
-std::string glb_json(const std::string& data, const std::string& where) {
-    if (data.size() < 20 || read_u32(data, 0) != kGlbMagic)
-        throw Error("not a GLB file (no 'glTF' magic)", where);
-    const std::uint32_t length = read_u32(data, 12), type = read_u32(data, 16);
-    if (type != kChunkJson || length > data.size() - 20)
-        throw Error("GLB file has no complete JSON chunk", where);
-    return data.substr(20, length);
-}
-
 std::string base64(const std::vector<unsigned char>& bytes) {
     static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     std::string out;
@@ -130,6 +120,15 @@ const char* accessor_type(int components) {
 }
 
 } // namespace
+
+std::string glb_json_chunk(const std::string& data, const std::string& where) {
+    if (data.size() < 20 || read_u32(data, 0) != kGlbMagic)
+        throw Error("not a GLB file (no 'glTF' magic)", where);
+    const std::uint32_t length = read_u32(data, 12), type = read_u32(data, 16);
+    if (type != kChunkJson || length > data.size() - 20)
+        throw Error("GLB file has no complete JSON chunk", where);
+    return data.substr(20, length);
+}
 
 struct GltfAsset::State {
     std::filesystem::path source_dir;
@@ -227,7 +226,7 @@ GltfAsset GltfAsset::load(const std::filesystem::path& path, const ImportLimits&
     state->loaded_attributes = state->mesh.attributes;
     state->loaded_colors = state->mesh.colors;
     try {
-        state->document = Json::parse(binary ? glb_json(data, where) : data);
+        state->document = Json::parse(binary ? glb_json_chunk(data, where) : data);
     } catch (const nlohmann::json::exception& e) {
         throw Error(fmt::format("malformed glTF JSON: {}", e.what()), where);
     }
