@@ -153,6 +153,23 @@ export function glossyMap(light, exponent, width = 128, height = 64) {
   return out;
 }
 
+// glossyMap() as half floats, once per light object and map: the hooks of a
+// model's many meshes share one light per sun position.
+const glossyCache = new WeakMap();
+function glossyTexels(light, exponent, width, height) {
+  let perLight = glossyCache.get(light);
+  if (!perLight) glossyCache.set(light, (perLight = new Map()));
+  const key = `${exponent} ${width}x${height}`;
+  let texels = perLight.get(key);
+  if (!texels) {
+    const map = glossyMap(light, exponent, width, height);
+    texels = new Uint16Array(map.length);
+    for (let i = 0; i < map.length; ++i) texels[i] = DataUtils.toHalfFloat(map[i]);
+    perLight.set(key, texels);
+  }
+  return texels;
+}
+
 // Adds the sky's SH light to `material` (MeshStandardMaterial,
 // MeshLambertMaterial, ...) through the baked data of the geometry it draws:
 //   mode 'prt': the transfer attributes _prt_0.._prt_{M-1} (three.js's
@@ -269,9 +286,8 @@ export function skybakeLighting(material, { mode = 'prt', prtGlsl, attributes = 
         if (i < uniforms.skybakeLight.value.length) uniforms.skybakeLight.value[i].set(c[0], c[1], c[2]);
       });
       if (glossy) {
-        const map = glossyMap(light, glossy.exponent, glossyWidth, glossyHeight);
         const texture = uniforms.skybakeGlossy.value;
-        for (let i = 0; i < map.length; ++i) texture.image.data[i] = DataUtils.toHalfFloat(map[i]);
+        texture.image.data = glossyTexels(light, glossy.exponent, glossyWidth, glossyHeight);
         texture.needsUpdate = true;
       }
     },
