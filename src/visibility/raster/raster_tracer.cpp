@@ -729,6 +729,7 @@ void RasterTracer::trace_cube(const TraceChunk& chunk) {
     std::vector<glm::mat4> views(std::size_t(s.batch) * kFaces);
     std::vector<glm::vec4> eyes(views.size());
     std::vector<GpuVertex> vertices(s.batch);
+    std::vector<std::vector<std::uint32_t>> lists; // per layer: the triangles binned to it
     std::vector<std::uint32_t> binned;
     std::vector<DrawElementsCommand> commands;
     const GLint fs_far = uniform(s.draw.get(), "u_far");
@@ -778,7 +779,9 @@ void RasterTracer::trace_cube(const TraceChunk& chunk) {
         // a hemisphere, and a triangle mostly falls in one or two of its five
         // faces): the rasteriser, whose cost is per triangle on llvmpipe,
         // then sets up about a fifth of vertices × 5 × triangles.
-        std::vector<std::vector<std::uint32_t>> lists(std::size_t(count) * kFaces);
+        lists.resize(std::size_t(count) * kFaces); // kept from batch to batch: no allocation once grown
+        for (std::vector<std::uint32_t>& l : lists)
+            l.clear();
         parallel_for(count, 4, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) {
                 const GpuVertex& g = vertices[i];
