@@ -301,6 +301,21 @@ void GltfAsset::save(const std::filesystem::path& path) const {
         doc["asset"] = Json::object();
     Json& views = doc["bufferViews"];
     Json& accessors = doc["accessors"];
+    // Appends `bytes` to buffer 0 at a 4-byte boundary as a new bufferView
+    // (with `target` where it is not 0); returns the view's index.
+    const auto append_view = [&](const void* bytes, std::size_t size, int target) {
+        while (bin.size() % 4)
+            bin.push_back(0);
+        const std::size_t offset = bin.size();
+        bin.resize(offset + size);
+        if (size)
+            std::memcpy(bin.data() + offset, bytes, size);
+        Json view = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", size}};
+        if (target)
+            view["target"] = target;
+        views.push_back(view);
+        return views.size() - 1;
+    };
     Json& meshes = doc["meshes"];
     const Json original_meshes = meshes;
 
@@ -335,13 +350,8 @@ void GltfAsset::save(const std::filesystem::path& path) const {
                     d = len > 0.0 ? d / len : d;
                     local[3 * v] = float(d.x), local[3 * v + 1] = float(d.y), local[3 * v + 2] = float(d.z);
                 }
-            while (bin.size() % 4)
-                bin.push_back(0);
-            const std::size_t offset = bin.size(), bytes = local.size() * sizeof(float);
-            bin.resize(offset + bytes);
-            std::memcpy(bin.data() + offset, local.data(), bytes);
-            views.push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}, {"target", kArrayBuffer}});
-            accessors.push_back({{"bufferView", views.size() - 1},
+            const std::size_t view = append_view(local.data(), local.size() * sizeof(float), kArrayBuffer);
+            accessors.push_back({{"bufferView", view},
                                  {"componentType", kFloat},
                                  {"count", inst.vertex_count},
                                  {"type", accessor_type(a->components)}});
@@ -370,13 +380,8 @@ void GltfAsset::save(const std::filesystem::path& path) const {
             std::error_code ec;
             if (ext == ".glb" && local && !mime.empty() && std::filesystem::is_regular_file(file, ec)) {
                 const std::string bytes = read_file(file);
-                while (bin.size() % 4)
-                    bin.push_back(0);
-                const std::size_t offset = bin.size();
-                bin.insert(bin.end(), bytes.begin(), bytes.end());
-                views.push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes.size()}});
                 image.erase("uri");
-                image["bufferView"] = views.size() - 1;
+                image["bufferView"] = append_view(bytes.data(), bytes.size(), 0);
                 image["mimeType"] = mime;
             } else {
                 image["uri"] = relocate_uri(uri, s.source_dir, out_dir);
@@ -407,12 +412,9 @@ void GltfAsset::save(const std::filesystem::path& path) const {
         if (image == images.size())
             images.push_back(Json::object());
         if (embed) {
-            while (bin.size() % 4)
-                bin.push_back(0);
-            const std::size_t offset = bin.size();
-            bin.insert(bin.end(), s.occlusion_png.begin(), s.occlusion_png.end());
-            views.push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", s.occlusion_png.size()}});
-            images[image] = {{"name", uri}, {"bufferView", views.size() - 1}, {"mimeType", "image/png"}};
+            images[image] = {{"name", uri},
+                             {"bufferView", append_view(s.occlusion_png.data(), s.occlusion_png.size(), 0)},
+                             {"mimeType", "image/png"}};
         } else {
             images[image] = {{"uri", uri}};
         }
@@ -450,12 +452,7 @@ void GltfAsset::save(const std::filesystem::path& path) const {
         for (const std::string& png : l.faces) {
             Json image = {{"mimeType", "image/png"}};
             if (ext == ".glb") {
-                while (bin.size() % 4)
-                    bin.push_back(0);
-                const std::size_t offset = bin.size();
-                bin.insert(bin.end(), png.begin(), png.end());
-                views.push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", png.size()}});
-                image["bufferView"] = views.size() - 1;
+                image["bufferView"] = append_view(png.data(), png.size(), 0);
             } else {
                 image = {{"uri", "data:image/png;base64," + base64(std::vector<unsigned char>(png.begin(), png.end()))}};
             }
