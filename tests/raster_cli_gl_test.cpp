@@ -61,17 +61,19 @@ TEST(RasterCli, BakesWithBothMethods) {
     EXPECT_NEAR(mean[0], embree, 0.01);
     EXPECT_NEAR(mean[1], embree, 0.02);
     // The default method is cube, at the resolution the rule asks for: texels
-    // of at most half the mean spacing √(4π/N) at a face's centre, from 16 up
-    // (lebedev:50: spacing 0.50 rad, and π/2 / 16 = 0.098 rad is below half of
-    // it; lebedev:5810: spacing 0.0465, 128 is the first with π/2 / r ≤ 0.0233).
+    // no wider than the mean spacing √(4π/N) at a face's centre, a multiple of
+    // 8 from 16 up (lebedev:50: spacing 0.50 rad, and π/2 / 16 = 0.098 rad is
+    // below it; lebedev:2030: spacing 0.0787, π/2 / 0.0787 = 19.96 → 24;
+    // lebedev:5810: spacing 0.0465, π/2 / 0.0465 = 33.8 → 40).
     r = run_cli({"ao", in, "-o", dir + "/wall_default.glb", "--rule", "lebedev:50", "--backend", "raster", "--json"});
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["method"], "cube");
     EXPECT_EQ(j["resolution"], 16);
     EXPECT_EQ(skybake::raster_cube_resolution(50), 16u);
-    EXPECT_EQ(skybake::raster_cube_resolution(590), 32u);
-    EXPECT_EQ(skybake::raster_cube_resolution(5810), 128u);
+    EXPECT_EQ(skybake::raster_cube_resolution(590), 16u);
+    EXPECT_EQ(skybake::raster_cube_resolution(2030), 24u);
+    EXPECT_EQ(skybake::raster_cube_resolution(5810), 40u);
     EXPECT_EQ(skybake::raster_cube_resolution(1000000), 256u);
 }
 

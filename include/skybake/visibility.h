@@ -299,10 +299,11 @@ std::unique_ptr<VisibilityTracer> make_visibility_tracer(const std::string& name
 
 // The raster backend's default resolutions, and the largest it takes. The
 // cube method's follows the rule: faces whose texels, at their centre, are
-// half the rule's mean spacing √(4π/N) or finer (π/2 / resolution ≤
-// spacing / 2), the power of two from 16 to 256 that gives it (32 for
-// lebedev:590, 128 for lebedev:5810). The directions whose texels disagree
-// with their neighbours are traced by rays, so a coarse cube stays exact.
+// no wider than the rule's mean spacing √(4π/N) (π/2 / resolution ≤
+// spacing), rounded up to a multiple of 8 from 16 to 256 (16 for
+// lebedev:590, 24 for lebedev:2030, 40 for lebedev:5810). The cube finds the
+// blockers; every direction whose texel or its eight neighbours disagree is
+// traced by a ray, so a coarse cube stays exact at blockers' edges.
 std::uint32_t raster_cube_resolution(std::size_t rule_points);
 inline constexpr std::uint32_t kRasterDirectionalResolution = 2048;
 inline constexpr std::uint32_t kRasterMaxResolution = 8192;

@@ -7,10 +7,12 @@
 #include <cstddef>
 #include <cmath>
 #include <cstdlib>
+#include <future>
 #include <limits>
 #include <vector>
 
 #include <fmt/format.h>
+
 #include <glm/geometric.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/mat4x4.hpp>
@@ -28,10 +30,8 @@ namespace skybake {
 
 std::uint32_t raster_cube_resolution(std::size_t rule_points) {
     const double spacing = std::sqrt(4.0 * M_PI / double(std::max<std::size_t>(rule_points, 1)));
-    std::uint32_t r = 16;
-    while (r < 256 && 0.5 * M_PI / double(r) > 0.5 * spacing)
-        r *= 2;
-    return r;
+    const double texels = 0.5 * M_PI / spacing; // a texel no wider than the spacing at the face's centre
+    return std::clamp<std::uint32_t>(8 * std::uint32_t(std::ceil(texels / 8.0)), 16, 256);
 }
 
 } // namespace skybake
@@ -50,9 +50,10 @@ constexpr std::uint64_t kChunkBytes = std::uint64_t(256) << 20;
 // origin a blocker that touches the vertex (a wall at the foot of which a
 // ground vertex lies) is a few 1e-6 of the scene away, and a near plane at
 // 1e-6 of the far one clipped it away: those vertices read open. The depth
-// is written linearly (gl_FragDepth), and x and y do not depend on the near
-// plane, so a tiny one costs no precision; 2^-40 keeps it positive and
-// finite in float for any far plane the batch can have.
+// is near / distance along the face's axis (reversed z, cube_projection()),
+// which a float keeps to 2^-24 relative at any distance, and x and y do not
+// depend on the near plane, so a tiny one costs no precision; 2^-40 keeps
+// it positive and finite in float for any far plane the batch can have.
 constexpr float kNearFraction = 0x1p-40f;
 constexpr int kFaces = 5;
 // Triangles per cluster of the cube method's binning.
@@ -80,6 +81,68 @@ CubeFrusta cube_frusta(const glm::vec3& t, const glm::vec3& b, const glm::vec3& 
     return f;
 }
 
+// A cube face's projection: a 90° square frustum with reversed z and no far
+// plane: clip z = near and clip w = d, the distance along the face's axis,
+// so that with GL_ZERO_TO_ONE clipping the depth is near / d in (0, 1],
+// nearer is greater, and the clipper keeps d ≥ near. The fragment shader
+// then writes nothing (llvmpipe tests depth early and runs no shader), and
+// the compute pass recovers d per texel. The side faces are whole squares
+// too: their lower halves (below the horizon) are drawn but never read.
+glm::mat4 cube_projection(float near) {
+    glm::mat4 m = glm::frustum(-near, near, -near, near, near, 2.0f * near); // x, y and w rows
+    m[0][2] = 0.0f, m[1][2] = 0.0f, m[2][2] = 0.0f, m[3][2] = near;
+    return m;
+}
+
+// Whether a triangle may cover a texel centre of a cube face of
+// resolution² texels (w, u and v: three values each): GL draws only the fragments whose centre the triangle
+// contains (OpenGL 4.6, section 14.6.1). Its corners k are given in the
+// face's terms: distance w[k] along the face's axis and (u[k], v[k]) across
+// it, so that they project to (u, v) / w in [−1, 1]². Every face is a full
+// 90° square (the side faces' lower halves are drawn but never read), so
+// the texel grid is the same under the square's symmetries and the
+// orientation of (u, v) does not matter. Far parts of a mesh are mostly
+// triangles that cover no centre at the resolutions the rules need. Kept
+// when a corner is not in front of the eye (the clipper decides), and
+// within a margin of 1/64 texel, far above the rasteriser's snapping of
+// vertices to 1/256.
+bool may_cover_a_centre(const float* w, const float* u, const float* v, float resolution) {
+    constexpr float margin = 1.0f / 64.0f;
+    glm::vec2 p[3];
+    glm::vec2 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (int k = 0; k < 3; ++k) {
+        if (!(w[k] > 0.0f))
+            return true;
+        p[k] = (glm::vec2(u[k], v[k]) / w[k] * 0.5f + 0.5f) * resolution;
+        lo = glm::min(lo, p[k]);
+        hi = glm::max(hi, p[k]);
+    }
+    // The centres i + 1/2 in [lo − margin, hi + margin].
+    const glm::vec2 first = glm::ceil(lo - margin - 0.5f), last = glm::floor(hi + margin - 0.5f);
+    if (first.x > last.x || first.y > last.y)
+        return false;
+    if ((last.x - first.x) + (last.y - first.y) > 2.0f)
+        return true; // more than a few centres: not worth testing one by one
+    // A few centres: is one of them inside the triangle, each edge moved out
+    // by the margin?
+    const float area = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x);
+    if (!(std::abs(area) > 1e-12f))
+        return true; // degenerate in window space: left to the rasteriser
+    const float sign = area > 0.0f ? 1.0f : -1.0f;
+    for (float y = first.y; y <= last.y; y += 1.0f)
+        for (float x = first.x; x <= last.x; x += 1.0f) {
+            const glm::vec2 c(x + 0.5f, y + 0.5f);
+            bool inside = true;
+            for (int k = 0; k < 3 && inside; ++k) {
+                const glm::vec2 e = p[(k + 1) % 3] - p[k];
+                inside = sign * (e.x * (c.y - p[k].y) - e.y * (c.x - p[k].x)) >= -margin * glm::length(e);
+            }
+            if (inside)
+                return true;
+        }
+    return false;
+}
+
 // Appends to faces[f] (kFaces lists) the numbers of the mesh's triangles
 // that may cover face f of the hemicube at `origin`. A triangle is left out
 // only when its three corners lie outside one plane of the face's frustum by
@@ -87,10 +150,12 @@ CubeFrusta cube_frusta(const glm::vec3& t, const glm::vec3& b, const glm::vec3& 
 // triangle the rasteriser could draw is kept (touching ones included). A
 // cluster's bounding sphere decides for all its triangles when it lies
 // wholly outside a plane, or wholly inside the frustum, or beyond t_max (the
-// rule's maximum distance) from the origin.
+// rule's maximum distance) from the origin. Of the rest, those that cover no
+// texel centre of the face (may_cover_a_centre()) are left out, unless
+// resolution is 0.
 void bin_cube_faces(const std::vector<glm::vec3>& positions, const std::vector<std::uint32_t>& indices,
                     const std::vector<glm::vec4>& clusters, const glm::vec3& origin, const glm::vec3& t,
-                    const glm::vec3& b, const glm::vec3& n, const CubeFrusta& f, float t_max,
+                    const glm::vec3& b, const glm::vec3& n, const CubeFrusta& f, float t_max, float resolution,
                     std::vector<std::uint32_t>* faces) {
     const std::size_t triangles = indices.size() / 3;
     for (std::size_t c = 0; c < clusters.size(); ++c) {
@@ -110,10 +175,7 @@ void bin_cube_faces(const std::vector<glm::vec3>& positions, const std::vector<s
                 inside = inside && d > reach * 1.00001f;
             }
             state[face] = out ? 0 : inside ? 2 : 1;
-            if (state[face] == 2)
-                for (std::size_t tri = first; tri < last; ++tri)
-                    faces[face].push_back(std::uint32_t(tri));
-            any = any || state[face] == 1;
+            any = any || state[face] != 0;
         }
         if (!any)
             continue;
@@ -144,8 +206,13 @@ void bin_cube_faces(const std::vector<glm::vec3>& positions, const std::vector<s
                 default: return !(outside(-1, -1, 0) || outside(1, -1, 0) || outside(0, -1, -1));
                 }
             };
+            // Each face's axis and the two across it (cube_frusta()'s order).
+            const float na[3] = {-a[0], -a[1], -a[2]}, ne[3] = {-e[0], -e[1], -e[2]};
+            const float* axis[kFaces] = {h, a, na, e, ne};
+            const float* across[kFaces][2] = {{a, e}, {e, h}, {e, h}, {a, h}, {a, h}};
             for (int face = 0; face < kFaces; ++face)
-                if (state[face] == 1 && keep(face))
+                if ((state[face] == 2 || (state[face] == 1 && keep(face))) &&
+                    (resolution == 0.0f || may_cover_a_centre(axis[face], across[face][0], across[face][1], resolution)))
                     faces[face].push_back(std::uint32_t(tri));
         }
     }
@@ -247,6 +314,9 @@ struct RasterTracer::State {
     // Mesa, NVIDIA); else a geometry shader does. SKYBAKE_RASTER_GEOMETRY_SHADER=1
     // forces the geometry shader (tests of that path).
     bool vs_layer = false;
+    // Cube: leave out the triangles that cover no texel centre (bin_cube_faces).
+    // SKYBAKE_RASTER_DRAW_ALL=1 keeps them (tests that the bits are the same).
+    bool centre_test = true;
 
     // The CPU tracer's own structure of the same mesh: the rays of the
     // directional near field (answer_near_field) and of the cube's edges
@@ -281,6 +351,8 @@ RasterTracer::RasterTracer(TraceMethod method, std::uint32_t resolution)
                     "backend");
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &s_->max_layers);
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &s_->max_size);
+    const char* draw_all = std::getenv("SKYBAKE_RASTER_DRAW_ALL");
+    s_->centre_test = !(draw_all && *draw_all == '1');
     const char* force_gs = std::getenv("SKYBAKE_RASTER_GEOMETRY_SHADER");
     s_->vs_layer = epoxy_has_gl_extension("GL_ARB_shader_viewport_layer_array") && !(force_gs && *force_gs == '1');
     if (GLint(resolution_) > s_->max_size)
@@ -289,6 +361,11 @@ RasterTracer::RasterTracer(TraceMethod method, std::uint32_t resolution)
             "resolution");
     if (method_ == TraceMethod::Cube && s_->max_layers < kFaces)
         throw Error("this OpenGL has too few texture array layers for a hemicube", "backend");
+    if (!s_->context->at_least(4, 5) && !epoxy_has_gl_extension("GL_ARB_clip_control"))
+        throw Error(fmt::format("the raster backend needs OpenGL 4.5 or GL_ARB_clip_control (reversed depth); the "
+                                "context is {}",
+                                s_->context->description()),
+                    "backend");
     s_->vao = gl::make_vertex_array();
     s_->views = storage_buffer(0);
     s_->eyes = storage_buffer(0);
@@ -500,12 +577,15 @@ namespace {
 // Binds the draw state shared by both methods: the depth array as the target,
 // depth test LESS, the mesh, the per-layer buffers. `cull` is the face that
 // rays pass through (GL_FRONT, GL_BACK), or GL_NONE.
+// reversed: the cube's reversed z (cube_projection()): depth in [0, 1] from
+// clip z / w, cleared to 0, nearer is greater.
 void begin_draw(GLuint fbo, std::uint32_t resolution, GLuint program, GLuint vao, GLuint views, GLuint eyes,
-                GLenum cull) {
+                GLenum cull, bool reversed) {
     glBindFramebuffer(GL_FRAMEBUFFER, fbo);
     glViewport(0, 0, GLsizei(resolution), GLsizei(resolution));
     glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
+    glClipControl(GL_LOWER_LEFT, reversed ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
+    glDepthFunc(reversed ? GL_GREATER : GL_LESS);
     glDepthMask(GL_TRUE);
     if (cull == GL_NONE) {
         glDisable(GL_CULL_FACE);
@@ -515,7 +595,7 @@ void begin_draw(GLuint fbo, std::uint32_t resolution, GLuint program, GLuint vao
         glCullFace(cull);
     }
     glDisable(GL_BLEND);
-    glClearDepth(1.0);
+    glClearDepth(reversed ? 0.0 : 1.0);
     glClear(GL_DEPTH_BUFFER_BIT);
     glUseProgram(program);
     glBindVertexArray(vao);
@@ -718,6 +798,23 @@ void RasterTracer::run_bits(const BitsPass& pass) {
     dispatch(std::uint64_t(pass.count) * pass.word_count);
 }
 
+// Cube: one batch of vertices, as the CPU prepares it (trace_cube).
+struct CubeBatch {
+    std::uint32_t first = 0, count = 0;
+    float near = 0.0f;
+    std::vector<glm::mat4> views; // per layer
+    std::vector<glm::vec4> eyes;  // per layer
+    std::vector<GpuVertex> vertices;
+    std::vector<std::vector<std::uint32_t>> lists; // per layer: the triangles binned to it
+    std::vector<std::uint32_t> indices;            // the layers' triangles, 16-bit pairs where short_indices
+    std::vector<DrawElementsCommand> commands;
+    std::size_t triangles = 0;
+    bool short_indices = false;
+};
+
+// Batches are drawn while the CPU bins the next one: llvmpipe's front end
+// keeps one core busy during a draw, and binning the next batch takes the
+// other.
 void RasterTracer::trace_cube(const TraceChunk& chunk) {
     State& s = *s_;
     const TraceRule& rule = s.rule;
@@ -726,18 +823,15 @@ void RasterTracer::trace_cube(const TraceChunk& chunk) {
         s.vertex_buffer = storage_buffer(s.batch * sizeof(GpuVertex));
         s.vertex_capacity = s.batch;
     }
-    std::vector<glm::mat4> views(std::size_t(s.batch) * kFaces);
-    std::vector<glm::vec4> eyes(views.size());
-    std::vector<GpuVertex> vertices(s.batch);
-    std::vector<std::vector<std::uint32_t>> lists; // per layer: the triangles binned to it
-    std::vector<std::uint32_t> binned;
-    std::vector<DrawElementsCommand> commands;
-    const GLint fs_far = uniform(s.draw.get(), "u_far");
-    for (std::uint32_t first = 0; first < chunk.count; first += s.batch) {
-        check_interrupted();
+    const float resolution = s.centre_test ? float(resolution_) : 0.0f; // 0: no texel-centre test
+    // CPU only (it runs beside the GL calls of the batch before).
+    const auto prepare = [&s, &rule, &chunk, resolution](std::uint32_t first, CubeBatch& c) {
         const std::uint32_t count = std::min(s.batch, chunk.count - first);
+        c.first = first;
+        c.count = count;
         // One far plane for the batch: past every point of the mesh from every
         // origin in it (and no further than needed for a maximum distance).
+        // The depth does not use it (reversed z has none): it sets the near one.
         float far = 0.0f;
         for (std::uint32_t i = 0; i < count; ++i)
             far = std::max(far, glm::length(chunk.origins[first + i] - s.centre) + s.radius);
@@ -745,23 +839,25 @@ void RasterTracer::trace_cube(const TraceChunk& chunk) {
         if (std::isfinite(rule.t_max))
             far = std::min(far, rule.t_max * 1.001f);
         far = std::max(far, 1e-30f);
-        const float near = std::max(far * kNearFraction, std::numeric_limits<float>::min());
-        const glm::mat4 top = glm::frustum(-near, near, -near, near, near, far);
-        const glm::mat4 side = glm::frustum(-near, near, 0.0f, near, near, far); // the half above the horizon
+        c.near = std::max(far * kNearFraction, std::numeric_limits<float>::min());
+        const glm::mat4 face = cube_projection(c.near);
+        c.views.resize(std::size_t(count) * kFaces);
+        c.eyes.resize(c.views.size());
+        c.vertices.resize(count);
         for (std::uint32_t i = 0; i < count; ++i) {
             const glm::vec3 o = chunk.origins[first + i], n = chunk.normals[first + i];
             glm::vec3 t, b;
             frame_of(n, t, b);
             const glm::vec3 zero(0.0f);
-            glm::mat4* v = &views[std::size_t(i) * kFaces];
-            v[0] = top * glm::lookAt(zero, n, b);
-            v[1] = side * glm::lookAt(zero, t, n);
-            v[2] = side * glm::lookAt(zero, -t, n);
-            v[3] = side * glm::lookAt(zero, b, n);
-            v[4] = side * glm::lookAt(zero, -b, n);
+            glm::mat4* v = &c.views[std::size_t(i) * kFaces];
+            v[0] = face * glm::lookAt(zero, n, b);
+            v[1] = face * glm::lookAt(zero, t, n);
+            v[2] = face * glm::lookAt(zero, -t, n);
+            v[3] = face * glm::lookAt(zero, b, n);
+            v[4] = face * glm::lookAt(zero, -b, n);
             for (int f = 0; f < kFaces; ++f)
-                eyes[std::size_t(i) * kFaces + f] = glm::vec4(o, 1.0f);
-            GpuVertex& g = vertices[i];
+                c.eyes[std::size_t(i) * kFaces + f] = glm::vec4(o, 1.0f);
+            GpuVertex& g = c.vertices[i];
             g.origin = glm::vec4(o, 1.0f);
             g.t = glm::vec4(t, 0.0f);
             g.b = glm::vec4(b, 0.0f);
@@ -771,78 +867,100 @@ void RasterTracer::trace_cube(const TraceChunk& chunk) {
             g.r1 = glm::vec4(r[1], 0.0f);
             g.r2 = glm::vec4(r[2], 0.0f);
         }
-        upload(s.views, views);
-        upload(s.eyes, eyes);
-        upload(s.vertex_buffer, vertices);
 
         // Each layer draws only the triangles that may cover it (a vertex sees
         // a hemisphere, and a triangle mostly falls in one or two of its five
-        // faces): the rasteriser, whose cost is per triangle on llvmpipe,
-        // then sets up about a fifth of vertices × 5 × triangles.
-        lists.resize(std::size_t(count) * kFaces); // kept from batch to batch: no allocation once grown
-        for (std::vector<std::uint32_t>& l : lists)
+        // faces, and far ones cover no texel centre): the rasteriser, whose
+        // cost is per triangle on llvmpipe, then sets up a small part of
+        // vertices × 5 × triangles.
+        c.lists.resize(std::size_t(count) * kFaces); // kept from batch to batch: no allocation once grown
+        for (std::vector<std::uint32_t>& l : c.lists)
             l.clear();
-        parallel_for(count, 4, [&](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i) {
-                const GpuVertex& g = vertices[i];
+        parallel_for(count, 4, [&](std::size_t lb, std::size_t le) {
+            for (std::size_t i = lb; i < le; ++i) {
+                const GpuVertex& g = c.vertices[i];
                 const glm::vec3 t(g.t), b(g.b), n(g.n);
                 bin_cube_faces(s.mesh_positions, s.mesh_indices, s.clusters, glm::vec3(g.origin), t, b, n,
-                               cube_frusta(t, b, n), rule.t_max, &lists[i * kFaces]);
+                               cube_frusta(t, b, n), rule.t_max, resolution, &c.lists[i * kFaces]);
             }
         });
-        std::vector<std::size_t> at(lists.size() + 1, 0);
-        commands.clear();
-        for (std::size_t layer = 0; layer < lists.size(); ++layer) {
-            if (!lists[layer].empty()) // an empty face stays cleared: no draw (each costs, even empty)
-                commands.push_back({GLuint(3 * lists[layer].size()), 1, GLuint(at[layer]), 0, GLuint(layer)});
-            at[layer + 1] = at[layer] + 3 * lists[layer].size();
+        std::vector<std::size_t> at(c.lists.size() + 1, 0);
+        c.commands.clear();
+        for (std::size_t layer = 0; layer < c.lists.size(); ++layer) {
+            if (!c.lists[layer].empty()) // an empty face stays cleared: no draw
+                c.commands.push_back({GLuint(3 * c.lists[layer].size()), 1, GLuint(at[layer]), 0, GLuint(layer)});
+            at[layer + 1] = at[layer] + 3 * c.lists[layer].size();
         }
         const std::size_t total = at.back();
+        c.triangles = total / 3;
         // 16-bit indices where the mesh allows: half the bytes to write and upload.
-        const bool short_indices = s.mesh_positions.size() <= 65536;
-        binned.resize(short_indices ? (total + 1) / 2 : total);
-        parallel_for(lists.size(), 8, [&](std::size_t lb, std::size_t le) {
+        c.short_indices = s.mesh_positions.size() <= 65536;
+        c.indices.resize(c.short_indices ? (total + 1) / 2 : total);
+        parallel_for(c.lists.size(), 8, [&](std::size_t lb, std::size_t le) {
             for (std::size_t layer = lb; layer < le; ++layer) {
                 std::size_t q = at[layer];
-                for (const std::uint32_t tri : lists[layer]) {
+                for (const std::uint32_t tri : c.lists[layer]) {
                     const std::uint32_t* v = &s.mesh_indices[3 * std::size_t(tri)];
-                    if (short_indices) {
-                        auto* out = reinterpret_cast<std::uint16_t*>(binned.data());
+                    if (c.short_indices) {
+                        auto* out = reinterpret_cast<std::uint16_t*>(c.indices.data());
                         out[q] = std::uint16_t(v[0]), out[q + 1] = std::uint16_t(v[1]), out[q + 2] = std::uint16_t(v[2]);
                     } else {
-                        binned[q] = v[0], binned[q + 1] = v[1], binned[q + 2] = v[2];
+                        c.indices[q] = v[0], c.indices[q + 1] = v[1], c.indices[q + 2] = v[2];
                     }
                     q += 3;
                 }
             }
         });
-        const std::size_t bytes = short_indices ? 2 * total : 4 * total;
-        glBindVertexArray(s.cube_vao.get());
-        glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(std::max<std::size_t>(bytes, 4)), binned.data(), GL_STREAM_DRAW);
-        glBindBuffer(GL_DRAW_INDIRECT_BUFFER, s.commands.get());
-        glBufferData(GL_DRAW_INDIRECT_BUFFER, GLsizeiptr(commands.size() * sizeof(DrawElementsCommand)),
-                     commands.data(), GL_STREAM_DRAW);
-        drawn_triangles_ += total / 3;
+    };
 
-        // Rays from the origin meet a triangle from behind where the camera at
-        // the origin sees its back: GL's back faces (the views do not mirror).
-        begin_draw(s.fbo.get(), resolution_, s.draw.get(), s.cube_vao.get(), s.views.get(), s.eyes.get(),
-                   s.vs_layer && s.back_faces == BackFaces::Ignore ? GL_BACK : GL_NONE);
-        glUniform1f(fs_far, far);
-        glMultiDrawElementsIndirect(GL_TRIANGLES, short_indices ? GL_UNSIGNED_SHORT : GL_UNSIGNED_INT, nullptr,
-                                    GLsizei(commands.size()), 0);
-        glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+    CubeBatch batches[2];
+    prepare(0, batches[0]);
+    for (std::uint32_t first = 0, k = 0; first < chunk.count; first += s.batch, k ^= 1) {
+        check_interrupted();
+        CubeBatch& c = batches[k];
+        const std::uint32_t next = first + s.batch;
+        std::future<void> ahead;
+        if (next < chunk.count)
+            ahead = std::async(std::launch::async, [&prepare, next, &batches, k] { prepare(next, batches[k ^ 1]); });
+        try {
+            upload(s.views, c.views);
+            upload(s.eyes, c.eyes);
+            upload(s.vertex_buffer, c.vertices);
+            const std::size_t bytes = c.short_indices ? 2 * 3 * c.triangles : 4 * 3 * c.triangles;
+            glBindVertexArray(s.cube_vao.get());
+            glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(std::max<std::size_t>(bytes, 4)), c.indices.data(),
+                         GL_STREAM_DRAW);
+            glBindBuffer(GL_DRAW_INDIRECT_BUFFER, s.commands.get());
+            glBufferData(GL_DRAW_INDIRECT_BUFFER, GLsizeiptr(c.commands.size() * sizeof(DrawElementsCommand)),
+                         c.commands.data(), GL_STREAM_DRAW);
+            drawn_triangles_ += c.triangles;
 
-        BitsPass pass;
-        pass.count = count;
-        pass.first = first;
-        pass.first_word = 0;
-        pass.word_count = wpv;
-        pass.first_point = 0;
-        pass.last_point = std::uint32_t(rule.points.size());
-        pass.far = far;
-        run_bits(pass);
-        gl::check_gl("raster backend cube pass");
+            // Rays from the origin meet a triangle from behind where the camera
+            // at the origin sees its back: GL's back faces (the views do not
+            // mirror).
+            begin_draw(s.fbo.get(), resolution_, s.draw.get(), s.cube_vao.get(), s.views.get(), s.eyes.get(),
+                       s.vs_layer && s.back_faces == BackFaces::Ignore ? GL_BACK : GL_NONE, true);
+            glMultiDrawElementsIndirect(GL_TRIANGLES, c.short_indices ? GL_UNSIGNED_SHORT : GL_UNSIGNED_INT, nullptr,
+                                        GLsizei(c.commands.size()), 0);
+            glBindBuffer(GL_DRAW_INDIRECT_BUFFER, 0);
+
+            BitsPass pass;
+            pass.count = c.count;
+            pass.first = c.first;
+            pass.first_word = 0;
+            pass.word_count = wpv;
+            pass.first_point = 0;
+            pass.last_point = std::uint32_t(rule.points.size());
+            pass.far = c.near; // the depth is near / distance along the face's axis
+            run_bits(pass);
+            gl::check_gl("raster backend cube pass");
+        } catch (...) {
+            if (ahead.valid())
+                ahead.wait(); // it reads `batches` and the chunk
+            throw;
+        }
+        if (ahead.valid())
+            ahead.get(); // rethrows what binning threw
     }
 }
 
@@ -890,7 +1008,7 @@ void RasterTracer::trace_directional(const TraceChunk& chunk) {
         // Rays along x travel towards the camera: they meet from behind the
         // triangles whose front the camera sees, GL's front faces.
         begin_draw(s.fbo.get(), resolution_, s.draw.get(), s.vao.get(), s.views.get(), s.eyes.get(),
-                   s.vs_layer && s.back_faces == BackFaces::Ignore ? GL_FRONT : GL_NONE);
+                   s.vs_layer && s.back_faces == BackFaces::Ignore ? GL_FRONT : GL_NONE, false);
         glDrawElementsInstanced(GL_TRIANGLES, s.index_count, GL_UNSIGNED_INT, nullptr, GLsizei(j1 - j0));
 
         BitsPass pass;

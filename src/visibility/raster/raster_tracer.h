@@ -64,7 +64,7 @@ private:
         std::uint32_t count = 0, first = 0;            // vertices, and the first one's slot in the chunk
         std::uint32_t first_word = 0, word_count = 0;  // the words written
         std::uint32_t first_point = 0, last_point = 0; // the directions drawn, [first, last)
-        float far = 0.0f;                              // cube: depth scale; directional: depth range
+        float far = 0.0f;                              // cube: the near plane; directional: depth range
         float texel = 0.0f;                            // directional: texel size (the normal offset)
     };
     void build_programs();

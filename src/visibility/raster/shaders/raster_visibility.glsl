@@ -8,10 +8,11 @@
 //
 // One layer is one view:
 //   cube         layer 5·v + f is face f of vertex v's hemicube, in the
-//                vertex's frame (t, b, n): f = 0 looks along n (the whole
-//                face), f = 1 ... 4 along +t, −t, +b, −b (their upper halves,
-//                n·x ≥ 0, stretched over the whole layer). The depth is the
-//                distance to the ray origin over u_far (gl_FragDepth).
+//                vertex's frame (t, b, n): f = 0 looks along n, f = 1 ... 4
+//                along +t, −t, +b, −b, each a 90° square (of the side faces
+//                only the upper half, n·x ≥ 0, is read). The depth is
+//                near / (distance along the face's axis), reversed z
+//                (raster_tracer.cpp: cube_projection), with no far plane.
 //   directional  layer j is an orthographic view along −x_j of the whole mesh,
 //                from outside its bounding sphere; the depth is linear.
 // Per layer, u_view[layer] takes world space (relative to u_eye[layer].xyz
@@ -93,14 +94,9 @@ void main() {
 #endif
 
 #if defined(SKYBAKE_STAGE_FS)
-in vec3 g_rel;
-uniform float u_far;
-void main() {
-#if defined(SKYBAKE_CUBE)
-    // The distance along the texel's ray, so that any surface drawn reads < 1.
-    gl_FragDepth = min(length(g_rel) / u_far, 0.99999994);
-#endif
-}
+// Depth only: the cube's depth comes from its projection (reversed z), the
+// directional maps' is linear.
+void main() {}
 #endif
 
 #if defined(SKYBAKE_STAGE_CS)
@@ -125,7 +121,7 @@ uniform int u_first_point; // directional: the batch's directions [u_first_point
 uniform int u_last_point;
 uniform int u_rotate;
 uniform int u_resolution;
-uniform float u_far;       // cube: depth scale; directional: the depth range
+uniform float u_far;       // cube: the near plane (depth = near / axial distance); directional: the depth range
 uniform float u_t_max;     // cube: occluders further are ignored
 uniform float u_lookup;    // directional: the normal offset, world units (kLookupTexels texels)
 uniform float u_recheck;   // directional: a blocker nearer than this beyond the look-up point (world units) is an edge
@@ -134,6 +130,22 @@ uniform int u_edge_offset; // directional: where the "edge" words start in u_wor
 ivec2 texel_of(vec2 ndc) {
     return clamp(ivec2(floor((ndc * 0.5 + 0.5) * float(u_resolution))), ivec2(0), ivec2(u_resolution - 1));
 }
+
+#if defined(SKYBAKE_CUBE)
+// Whether texel t of a cube face holds a surface within u_t_max of the ray
+// origin along the texel centre's ray. Its depth is near / d, d the distance
+// along the face's axis; the ray's length is d·|(X, Y, 1)|, with (X, Y) in
+// [−1, 1]² the centre's tangents.
+bool cube_hit(ivec2 t, int layer) {
+    const float depth = texelFetch(u_depth, ivec3(t, layer), 0).r;
+    if (!(depth > 0.0))
+        return false; // nothing drawn
+    if (u_t_max >= 3.0e38)
+        return true;
+    const vec2 c = (vec2(t) + 0.5) / float(u_resolution) * 2.0 - 1.0;
+    return u_far / depth * length(vec3(c, 1.0)) <= u_t_max;
+}
+#endif
 
 void main() {
     // Dispatches over 65,535 groups are 2D (raster_tracer.cpp: dispatch).
@@ -157,29 +169,22 @@ void main() {
         const int layer = 5 * v + face;
         const vec4 clip = u_view[layer] * vec4(x, 0.0);
         const vec2 ndc = clip.xy / clip.w;
-        const float depth = texelFetch(u_depth, ivec3(texel_of(ndc), layer), 0).r;
-        const bool hit = depth < 1.0 && depth * u_far <= u_t_max;
-        if (hit)
+        if (cube_hit(texel_of(ndc), layer))
             bits |= 1u << uint(j & 31);
         // The texel's centre stands for the direction: where the four texels
         // around the direction disagree, a blocker's edge passes within a
         // texel of it, and the CPU tracer answers instead (answer_edges); so
         // it does along the face's border.
-        const vec2 f = (ndc * 0.5 + 0.5) * float(u_resolution) - 0.5;
-        const ivec2 i0 = ivec2(floor(f));
+        const ivec2 i0 = ivec2(floor((ndc * 0.5 + 0.5) * float(u_resolution))) - 1;
         bool any_hit = false, any_open = false;
-        for (int dy = 0; dy < 2; ++dy)
-            for (int dx = 0; dx < 2; ++dx) {
+        for (int dy = 0; dy < 3; ++dy)
+            for (int dx = 0; dx < 3; ++dx) {
                 const ivec2 t = clamp(i0 + ivec2(dx, dy), ivec2(0), ivec2(u_resolution - 1));
-                const float d = texelFetch(u_depth, ivec3(t, layer), 0).r;
-                const bool h = d < 1.0 && d * u_far <= u_t_max;
+                const bool h = cube_hit(t, layer);
                 any_hit = any_hit || h;
                 any_open = any_open || !h;
             }
-        // Within half a texel of the face's border (where Lebedev rules put
-        // whole rings of directions, for an axis-aligned normal) the four
-        // texels are clamped to this face and cannot see the next one.
-        const bool border = any(lessThan(i0, ivec2(0))) || any(greaterThan(i0 + 1, ivec2(u_resolution - 1)));
+        const bool border = any(lessThan(i0, ivec2(0))) || any(greaterThan(i0 + 2, ivec2(u_resolution - 1)));
         if ((any_hit && any_open) || border)
             edge |= 1u << uint(j & 31);
 #else
