@@ -97,9 +97,10 @@ void add_sky_train(CLI::App& group) {
         o->t.inputs = parse_flag("--inputs", [&] { return parse_input_encoding(o->inputs); });
         if (given(*sub, "--outputs")) {
             o->t.outputs = parse_flag("--outputs", [&] { return parse_output_encoding(o->outputs); });
-            if (o->t.outputs == OutputEncoding::PhaseFactored && atm.scattering != Scattering::Single)
-                throw UsageError("phase-factored outputs are exact for single scattering only; use --outputs "
-                                 "radiance with multiple scattering",
+            if (has_phase_terms(o->t.outputs) && atm.scattering != Scattering::Single)
+                throw UsageError(fmt::format("{} outputs are for single scattering only; use --outputs radiance with "
+                                             "multiple scattering",
+                                             output_encoding_name(o->t.outputs)),
                                  "--outputs");
         } else
             o->t.outputs = atm.scattering == Scattering::Single ? OutputEncoding::PhaseFactored

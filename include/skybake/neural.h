@@ -103,8 +103,16 @@ enum class InputEncoding : int { Seed = 0, Horizon = 1 };
 // with S_k the in-scatter integral of scattering component k without its
 // phase function. The network learns each S_k per channel (3 outputs per
 // scattering component, each log-encoded over log_range below its own
-// maximum); the exact phase functions are applied outside it.
-enum class OutputEncoding : int { Radiance = 0, PhaseFactored = 1 };
+// maximum); the exact phase functions are applied outside it. "residual":
+// the phase-factored terms as corrections of an analytic single scattering,
+// a few-step march over the view ray's lit parts with Chapman-function sun
+// depths (src/neural/mlp_hd.h, analytic_terms): per term and channel the log
+// of S_k over the march's A_k. The march carries the decades (altitude, the
+// planet's shadow); the network the few tens of percent it misses. Single
+// scattering, and the terms' components must have exponential profiles.
+enum class OutputEncoding : int { Radiance = 0, PhaseFactored = 1, Residual = 2 };
+// Phase-factored and residual outputs: one term per scattering component.
+inline bool has_phase_terms(OutputEncoding e) { return e != OutputEncoding::Radiance; }
 const char* input_encoding_name(InputEncoding encoding);
 const char* output_encoding_name(OutputEncoding encoding);
 InputEncoding parse_input_encoding(const std::string& text, const std::string& where = "inputs");
@@ -124,7 +132,7 @@ struct NeuralEncoding {
     BrightnessEncoding brightness = BrightnessEncoding::Log; // Radiance only; phase-factored outputs are log
     double max_n = 1.0;      // max{N} over the max_n samples, radiance per unit sun irradiance (1/sr); > 0
     double log_range = 13.815510557964274; // Log: nats of N/max{N} (or S/max S) mapped onto [0.05, 0.95] (ln 1e6)
-    std::vector<PhaseTerm> terms; // PhaseFactored only: one per scattering component, 1 to 4
+    std::vector<PhaseTerm> terms; // PhaseFactored and Residual: one per scattering component, 1 to 4
 
     // Encoded outputs: 4 (radiance) or 3 per term.
     int output_count() const { return outputs == OutputEncoding::Radiance ? 4 : 3 * int(terms.size()); }

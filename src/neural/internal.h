@@ -33,6 +33,11 @@ struct Layout {
 Layout make_layout(const NeuralTopology& topology);
 // The encoding part of MlpHD (inputs, decoding constants, phase terms).
 void set_encoding_hd(const NeuralEncoding& encoding, const Atmosphere& atmosphere, MlpHD& m);
+// Throws skybake::Error (naming `where`) unless the atmosphere suits residual
+// outputs: single scattering, at most kMaxTerms exponential components, and
+// every term's component among them.
+void check_residual_atmosphere(const NeuralEncoding& encoding, const Atmosphere& atmosphere,
+                               const std::string& where);
 // Indices of the atmosphere's components that scatter (a phase function and
 // some scattering): the phase-factored terms, in order.
 std::vector<int> phase_term_components(const Atmosphere& atmosphere);
@@ -73,6 +78,11 @@ void encode_targets(const NeuralEncoding& encoding, std::span<const glm::vec3> r
 // sky::evaluate_sky_split); every output is trained (mask 1).
 void encode_split_targets(const NeuralEncoding& encoding, std::span<const glm::vec3> split, std::size_t components,
                           const std::vector<int>& term_components, MatF& targets, MatF& mask);
+// Residual targets: 0.5 + 0.45 clamp(ln(S/A)/kResidualRange, −1, 1) per term
+// and channel, A from `base` (analytic_matrix); masked out where S or A is 0
+// (nothing to correct: the output is A·ratio = 0 there, or S is 0).
+void encode_residual_targets(std::span<const glm::vec3> split, std::size_t components,
+                             const std::vector<int>& term_components, const MatF& base, MatF& targets, MatF& mask);
 
 // The random stream `stream` of a training seed: 0 training samples, 1
 // held-out, 2 max{N}, 3 initial weights, 4 shuffles.
@@ -81,6 +91,7 @@ std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t stream);
 // Training or held-out data: inputs, encoded targets, masks, and the reference radiance.
 struct TrainingData {
     MatF x, t, mask;
+    MatF base; // residual outputs: analytic_terms per sample (3 per term), else empty
     std::vector<glm::vec3> radiance;
     double mask_count = 0.0;
     std::size_t size() const { return radiance.size(); }
@@ -118,5 +129,7 @@ NeuralErrorReport measure_approximation_error(const SkyModel& model, double max_
 
 // Network inputs (4 × n) from samples, through the input encoding of m.
 MatF samples_to_matrix(const MlpHD& m, std::span<const SkySample> samples);
+// analytic_terms (3 per term × n) of the samples.
+MatF analytic_matrix(const MlpHD& m, std::span<const SkySample> samples);
 
 } // namespace skybake::neural

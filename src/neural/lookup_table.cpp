@@ -103,6 +103,8 @@ std::array<int, 4> grid_size(std::size_t nodes) {
 } // namespace
 
 SkyLookupTable fit_sky_lookup_table(const SkyModel& model, const NeuralTrainOptions& o, std::size_t floats) {
+    if (o.outputs == OutputEncoding::Residual)
+        throw Error("look-up tables hold radiance or phase-factored outputs, not residual ones", "outputs");
     SkyLookupTable t;
     t.encoding = make_training_encoding(model, o);
     t.atmosphere = model.atmosphere();

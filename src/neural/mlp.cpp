@@ -6,8 +6,11 @@
 #include <cassert>
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "core/parallel.h"
 #include "neural/internal.h"
+#include "skybake/error.h"
 
 namespace skybake {
 
@@ -80,14 +83,56 @@ void set_encoding_hd(const NeuralEncoding& e, const Atmosphere& atmosphere, MlpH
     m.R0 = float(atmosphere.planet_radius_km);
     m.Rtop = float(atmosphere.top_radius_km);
     m.scale_height = atmosphere.components.empty() ? 8.0f : float(atmosphere.components[0].scale_height_km);
-    m.output_kind = e.outputs == OutputEncoding::PhaseFactored ? kOutputsPhaseFactored : kOutputsRadiance;
-    m.terms = e.outputs == OutputEncoding::PhaseFactored ? int(std::min<std::size_t>(e.terms.size(), kMaxTerms)) : 0;
+    m.output_kind = e.outputs == OutputEncoding::Residual        ? kOutputsResidual
+                    : e.outputs == OutputEncoding::PhaseFactored ? kOutputsPhaseFactored
+                                                                 : kOutputsRadiance;
+    m.terms = has_phase_terms(e.outputs) ? int(std::min<std::size_t>(e.terms.size(), kMaxTerms)) : 0;
     for (int k = 0; k < m.terms; ++k) {
         const PhaseTerm& t = e.terms[std::size_t(k)];
         m.term_phase[k] = int(t.phase);
         m.term_g[k] = float(t.g);
         for (int c = 0; c < 3; ++c)
             m.term_max[k][c] = float(t.max_s[c]);
+    }
+    if (e.outputs != OutputEncoding::Residual)
+        return;
+    // The analytic march's atmosphere (check_residual_atmosphere has checked it fits).
+    m.ext_count = 0;
+    for (const AtmosphereComponent& c : atmosphere.components)
+        if (c.profile == DensityProfile::Exponential && m.ext_count < kMaxTerms) {
+            m.ext_height[m.ext_count] = float(c.scale_height_km);
+            for (int ch = 0; ch < 3; ++ch)
+                m.ext_beta[m.ext_count][ch] = float(c.extinction_per_km[ch]);
+            for (int k = 0; k < m.terms; ++k)
+                if (e.terms[std::size_t(k)].component == c.name) {
+                    m.term_ext[k] = m.ext_count;
+                    for (int ch = 0; ch < 3; ++ch)
+                        m.term_beta[k][ch] = float(c.scattering_per_km[ch]);
+                }
+            ++m.ext_count;
+        }
+}
+
+void check_residual_atmosphere(const NeuralEncoding& e, const Atmosphere& atmosphere, const std::string& where) {
+    if (atmosphere.scattering != Scattering::Single)
+        throw Error("residual outputs correct an analytic single scattering; train radiance outputs for an "
+                    "atmosphere with multiple scattering",
+                    where + ": encoding.outputs");
+    int exponential = 0;
+    for (const AtmosphereComponent& c : atmosphere.components)
+        exponential += c.profile == DensityProfile::Exponential ? 1 : 0;
+    if (exponential > kMaxTerms)
+        throw Error(fmt::format("residual outputs take at most {} exponential components, not {}", kMaxTerms,
+                                exponential),
+                    where + ": atmosphere.components");
+    for (const PhaseTerm& t : e.terms) {
+        const auto c = std::find_if(atmosphere.components.begin(), atmosphere.components.end(),
+                                    [&](const AtmosphereComponent& a) { return a.name == t.component; });
+        if (c == atmosphere.components.end() || c->profile != DensityProfile::Exponential)
+            throw Error(fmt::format("residual outputs need each scattering component to be exponential; '{}' is "
+                                    "not, or is missing from the atmosphere",
+                                    t.component),
+                        where + ": encoding.terms");
     }
 }
 
@@ -234,6 +279,42 @@ void encode_split_targets(const NeuralEncoding& encoding, std::span<const glm::v
     });
 }
 
+void encode_residual_targets(std::span<const glm::vec3> split, std::size_t components,
+                             const std::vector<int>& term_components, const MatF& base, MatF& targets, MatF& mask) {
+    const std::size_t n = split.size() / components;
+    const int outputs = 3 * int(term_components.size());
+    targets.resize(outputs, Eigen::Index(n));
+    mask.resize(outputs, Eigen::Index(n));
+    parallel_for(n, 4096, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i)
+            for (std::size_t k = 0; k < term_components.size(); ++k) {
+                const glm::vec3 v = split[i * components + std::size_t(term_components[k])];
+                for (int c = 0; c < 3; ++c) {
+                    const Eigen::Index row = Eigen::Index(3 * k + std::size_t(c));
+                    const double s = double(v[c]), a = double(base(row, Eigen::Index(i)));
+                    const bool lit = s > 0.0 && a > 0.0;
+                    const double x = lit ? std::clamp(std::log(s / a) / double(kResidualRange), -1.0, 1.0) : 0.0;
+                    targets(row, Eigen::Index(i)) = float(0.5 + 0.5 * double(kEncodeScale) * x);
+                    mask(row, Eigen::Index(i)) = lit ? 1.0f : 0.0f;
+                }
+            }
+    });
+}
+
+MatF analytic_matrix(const MlpHD& m, std::span<const SkySample> samples) {
+    MatF a(3 * m.terms, Eigen::Index(samples.size()));
+    parallel_for(samples.size(), 4096, [&](std::size_t b, std::size_t e) {
+        float base[kMaxOutputs];
+        for (std::size_t i = b; i < e; ++i) {
+            const SkySample& s = samples[i];
+            analytic_terms(m, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, base);
+            for (int k = 0; k < 3 * m.terms; ++k)
+                a(k, Eigen::Index(i)) = base[k];
+        }
+    });
+    return a;
+}
+
 float encode_log(double value, double max, double log_range) {
     if (!(value > 0.0))
         return 0.0f; // no light: below the offset, decoded as 0
@@ -290,9 +371,13 @@ void evaluate_neural_sky(const NeuralSky& net, std::span<const SkySample> sample
             const MatF x = samples_to_matrix(hd, samples.subspan(lo, hi - lo));
             enc.resize(hd.outputs, x.cols());
             forward_network(layout, net.weights.data(), x, enc, ws);
+            float base[kMaxOutputs];
             for (std::size_t i = lo; i < hi; ++i) {
-                assert(is_valid_sky_sample(samples[i], 1e-4));
-                out[i] = decode_sky(hd, enc.col(Eigen::Index(i - lo)).data(), samples[i].cos_view_sun);
+                const SkySample& s = samples[i];
+                assert(is_valid_sky_sample(s, 1e-4));
+                if (hd.output_kind == kOutputsResidual)
+                    analytic_terms(hd, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, base);
+                out[i] = decode_sky(hd, enc.col(Eigen::Index(i - lo)).data(), s.cos_view_sun, base);
             }
         }
     });

@@ -35,7 +35,11 @@ constexpr float kSlope = 1.38629436111989f;
 enum : int { kBrightnessLinear = 0, kBrightnessLog = 1 };
 // Values of skybake::InputEncoding and OutputEncoding.
 enum : int { kInputsSeed = 0, kInputsHorizon = 1 };
-enum : int { kOutputsRadiance = 0, kOutputsPhaseFactored = 1 };
+enum : int { kOutputsRadiance = 0, kOutputsPhaseFactored = 1, kOutputsResidual = 2 };
+// Residual outputs: steps of the analytic march per lit part of the view ray,
+// and the half range of the log ratio the network encodes (nats).
+constexpr int kResidualSteps = 4;
+constexpr float kResidualRange = 2.0f;
 
 struct MlpHD {
     const float* weights = nullptr; // subnets * subnet_params floats
@@ -57,6 +61,14 @@ struct MlpHD {
     int term_phase[kMaxTerms] = {};
     float term_g[kMaxTerms] = {};
     float term_max[kMaxTerms][3] = {};
+    // Residual: the analytic march's atmosphere, its exponential components
+    // (scale height km, extinction 1/km) and per term the component and its
+    // scattering (1/km).
+    int ext_count = 0;
+    float ext_height[kMaxTerms] = {};
+    float ext_beta[kMaxTerms][3] = {};
+    int term_ext[kMaxTerms] = {};
+    float term_beta[kMaxTerms][3] = {};
 };
 
 SKYBAKE_HD_INLINE float seed_activation(float x) { return 1.0f / (1.0f + exp2f(2.0f * x)); }
@@ -93,6 +105,34 @@ SKYBAKE_HD_INLINE void mlp_forward(const MlpHD& m, const float in[kInputs], floa
 
 constexpr float kHorizonGap = 0.25f, kHorizonSpan = 1.0f - kHorizonGap;
 
+// The observer and its view ray in km: altitude h = −H ln ρ0 in [0, Rtop −
+// R0] (H: scale height of the first component), r = R0 + h, ρ = √(r² − R0²)
+// and the length d of the ray to where it leaves the atmosphere or meets the
+// ground (ground: it does).
+struct ViewRayHD {
+    float h, r, rho, d;
+    bool ground;
+};
+SKYBAKE_HD_INLINE ViewRayHD view_ray(const MlpHD& m, float cos_view_zenith, float density) {
+    ViewRayHD v;
+    const float top = m.Rtop - m.R0;
+    float h = -m.scale_height * logf(density);
+    v.h = h > 0.0f ? (h < top ? h : top) : 0.0f;
+    v.r = m.R0 + v.h;
+    v.rho = sqrtf(v.h * (2.0f * m.R0 + v.h)); // √(r² − R0²)
+    const float rc = v.r * cos_view_zenith;
+    const float arc = fabsf(rc);
+    v.ground = cos_view_zenith < 0.0f && arc >= v.rho;
+    if (v.ground) {
+        const float disc = (arc - v.rho) * (arc + v.rho); // r² cos² − ρ²
+        v.d = -rc - sqrtf(disc > 0.0f ? disc : 0.0f);
+    } else {
+        const float disc = rc * rc + (top - v.h) * (2.0f * m.R0 + top + v.h); // r² cos² + Rtop² − r²
+        v.d = -rc + sqrtf(disc > 0.0f ? disc : 0.0f);
+    }
+    return v;
+}
+
 // The network's inputs from the sky function's arguments.
 //  seed:    (cos α0, cos β0, cos θ0, ρ0) as they are.
 //  horizon: altitude h = −H ln ρ0 (H: scale height of the first component),
@@ -121,27 +161,184 @@ SKYBAKE_HD_INLINE void encode_inputs(const MlpHD& m, float cos_view_zenith, floa
         return;
     }
     const float top = m.Rtop - m.R0;
-    float h = -m.scale_height * logf(density);
-    h = h > 0.0f ? (h < top ? h : top) : 0.0f;
-    const float r = m.R0 + h;
-    const float rho = sqrtf(h * (2.0f * m.R0 + h));     // √(r² − R0²)
-    const float H = sqrtf(top * (2.0f * m.R0 + top));   // √(Rtop² − R0²)
-    const float rc = r * cos_view_zenith;
-    const float arc = fabsf(rc);
-    if (cos_view_zenith < 0.0f && arc >= rho) { // the ray meets the ground
-        const float disc = (arc - rho) * (arc + rho);  // r² cos² − ρ²
-        const float d = -rc - sqrtf(disc > 0.0f ? disc : 0.0f);
-        const float span = rho - h;
-        const float t = span > 0.0f ? (d - h) / span : 0.0f;
+    const ViewRayHD v = view_ray(m, cos_view_zenith, density);
+    const float H = sqrtf(top * (2.0f * m.R0 + top)); // √(Rtop² − R0²)
+    if (v.ground) {
+        const float span = v.rho - v.h;
+        const float t = span > 0.0f ? (v.d - v.h) / span : 0.0f;
         in[0] = -(kHorizonGap + kHorizonSpan * (t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f));
     } else {
-        const float disc = rc * rc + (top - h) * (2.0f * m.R0 + top + h); // r² cos² + Rtop² − r²
-        const float d = -rc + sqrtf(disc > 0.0f ? disc : 0.0f);
-        const float span = rho + H - (top - h);
-        const float t = span > 0.0f ? (d - (top - h)) / span : 0.0f;
+        const float span = v.rho + H - (top - v.h);
+        const float t = span > 0.0f ? (v.d - (top - v.h)) / span : 0.0f;
         in[0] = kHorizonGap + kHorizonSpan * (t > 0.0f ? (t < 1.0f ? t : 1.0f) : 0.0f);
     }
-    in[3] = 2.0f * rho / H - 1.0f;
+    in[3] = 2.0f * v.rho / H - 1.0f;
+}
+
+// [SECTION] Residual outputs: an analytic single scattering the network corrects
+//
+// The network's outputs are log ratios to a cheap analytic single scattering
+// per phase term (analytic_terms), a few-step march in the spirit of O'Neil's
+// GPU Gems 2 sky shader, with three changes that make it follow the sky at
+// every altitude and at twilight:
+//  - the sun's optical depth at each step is a Chapman-function estimate,
+//    ρ(r) H Ch(x, cos χ), x = r/H, with Ch interpolating its zenith (1) and
+//    horizontal (√(πx/2)) limits, Ch ≈ c/((c − 1) cos χ + 1), c = √(πx/2);
+//    below the local horizon the whole grazing ray minus its backward half,
+//    2 ρ(x0) H √(π x0/2H) − ρ(r) H Ch(x, −cos χ), x0 = r sin χ the periapsis;
+//  - the march covers only the ray's lit parts: the planet's shadow of a
+//    parallel sun is one interval of the ray (shadow_span), so up to two lit
+//    parts of kResidualSteps midpoint steps each;
+//  - the view's optical depth is a trapezoid sum over the same points.
+// Only the exponential components take part (ozone-like tents and constant
+// shells are left to the network). The network's output x per term and
+// channel is S = A exp(R (x − 0.5)/0.45), R = kResidualRange.
+
+// The shadow interval of the ray's [0, d] (sky/planet_shadow_hd.h's, written
+// in float with cancellation-free terms so that the exported shaders repeat it
+// operation for operation): behind the terminator plane, r μs + t ν < 0, and
+// inside the cylinder of radius R0 along the sun, A t² + B t + C < 0 with
+// A = (1 − ν)(1 + ν), B = 2 r (μ − μs ν), C = (ρ − r μs)(ρ + r μs).
+// True with [lo, hi], lo < hi, where some of it is in shadow.
+SKYBAKE_HD_INLINE bool shadow_span(float r, float rho, float mu, float nu, float mu_s, float d, float& lo,
+                                   float& hi) {
+    lo = 0.0f;
+    hi = d;
+    const float c = r * mu_s;
+    if (nu > 0.0f) {
+        const float t = -c / nu;
+        hi = hi < t ? hi : t;
+    } else if (nu < 0.0f) {
+        const float t = -c / nu;
+        lo = lo > t ? lo : t;
+    } else if (!(c < 0.0f)) {
+        return false;
+    }
+    const float A = (1.0f - nu) * (1.0f + nu), B = 2.0f * r * (mu - mu_s * nu), C = (rho - c) * (rho + c);
+    if (A <= 1e-12f) { // along the sun: B t + C < 0
+        if (B > 0.0f) {
+            const float t = -C / B;
+            hi = hi < t ? hi : t;
+        } else if (B < 0.0f) {
+            const float t = -C / B;
+            lo = lo > t ? lo : t;
+        } else if (!(C < 0.0f)) {
+            return false;
+        }
+    } else {
+        const float D = B * B - 4.0f * A * C;
+        if (!(D > 0.0f))
+            return false;
+        const float q = -0.5f * (B + (B < 0.0f ? -sqrtf(D) : sqrtf(D)));
+        const float ta = q / A, tb = q != 0.0f ? C / q : -ta;
+        lo = lo > (ta < tb ? ta : tb) ? lo : (ta < tb ? ta : tb);
+        hi = hi < (ta < tb ? tb : ta) ? hi : (ta < tb ? tb : ta);
+    }
+    return lo < hi;
+}
+
+// ∫ ρ ds (km) from radius r towards cos χ to infinity, ρ = exp(−(r − R0)/H)
+// given as rho_r (the Chapman estimate above).
+SKYBAKE_HD_INLINE float chapman_depth(float r, float R0, float H, float cos_chi, float rho_r) {
+    const float c = sqrtf(1.57079632679f * r / H);
+    if (cos_chi >= 0.0f)
+        return H * rho_r * c / ((c - 1.0f) * cos_chi + 1.0f);
+    const float s2 = (1.0f - cos_chi) * (1.0f + cos_chi);
+    float x0 = r * sqrtf(s2 > 0.0f ? s2 : 0.0f);
+    x0 = x0 > R0 ? x0 : R0;
+    const float c0 = sqrtf(1.57079632679f * x0 / H);
+    return H * (2.0f * c0 * expf((R0 - x0) / H) - rho_r * c / ((c - 1.0f) * -cos_chi + 1.0f));
+}
+
+// ∫ ρ dt over [a, b] of the view ray from radius r, cos zenith μ, for an
+// exponential component of scale height H: differences of chapman_depth at
+// the ends, with the periapsis term (where the ray passes it) counted once.
+// The view's cosine (r μ + t)/|p(t)| only grows along the ray.
+SKYBAKE_HD_INLINE float chapman_segment(float R0, float H, float ra, float ca, float rho_a, float rb, float cb,
+                                        float rho_b) {
+    const float xa = 1.57079632679f * ra / H, xb = 1.57079632679f * rb / H;
+    const float qa = sqrtf(xa), qb = sqrtf(xb);
+    // Ch(x, |cos|) ρ H at each end: forward depth above the horizon, backward below.
+    const float fa = H * rho_a * qa / ((qa - 1.0f) * fabsf(ca) + 1.0f);
+    const float fb = H * rho_b * qb / ((qb - 1.0f) * fabsf(cb) + 1.0f);
+    if (ca >= 0.0f)
+        return fa - fb; // both ends above their horizons: forward(a) − forward(b)
+    if (cb < 0.0f)
+        return fb - fa; // both below: backward(b) − backward(a)
+    // Through the periapsis x0 = r sin χ: 2 ρ(x0) H Ch(x0, 0) − backward(a) − forward(b).
+    const float s2 = (1.0f - ca) * (1.0f + ca);
+    float x0 = ra * sqrtf(s2 > 0.0f ? s2 : 0.0f);
+    x0 = x0 > R0 ? x0 : R0;
+    return 2.0f * H * sqrtf(1.57079632679f * x0 / H) * expf((R0 - x0) / H) - fa - fb;
+}
+
+// The analytic single scattering A per phase term and channel (1/sr per unit
+// sun irradiance, without the phase function) into base[3 k + c]. In each lit
+// part the midpoint sum of each component's density is scaled to its
+// Chapman integral (chapman_segment), so that a steep profile (aerosols, a
+// 1.2 km scale height, on a 100 km ray) is not lost between the steps.
+SKYBAKE_HD_INLINE void analytic_terms(const MlpHD& m, float cos_view_zenith, float cos_view_sun, float cos_sun_zenith,
+                                      float density, float* base) {
+    for (int i = 0; i < 3 * m.terms; ++i)
+        base[i] = 0.0f;
+    const ViewRayHD v = view_ray(m, cos_view_zenith, density);
+    float lo, hi;
+    const bool shadow = shadow_span(v.r, v.rho, cos_view_zenith, cos_view_sun, cos_sun_zenith, v.d, lo, hi);
+    const float rho2 = v.rho * v.rho, two_r_mu = 2.0f * v.r * cos_view_zenith;
+    float prev[kMaxTerms], tau[3] = {0.0f, 0.0f, 0.0f}, t_prev = 0.0f;
+    for (int e = 0; e < m.ext_count; ++e)
+        prev[e] = expf(-v.h / m.ext_height[e]);
+    for (int part = 0; part < 2; ++part) {
+        const float a = part == 0 ? 0.0f : (shadow ? hi : v.d);
+        const float b = part == 0 ? (shadow ? lo : v.d) : v.d;
+        if (!(b > a))
+            continue;
+        const float dt = (b - a) * (1.0f / float(kResidualSteps));
+        float sum_rho[kMaxTerms] = {}, part_sum[kMaxOutputs] = {};
+        float r_end[2], c_end[2];
+        for (int j = 0; j < 2; ++j) {
+            const float t = j == 0 ? a : b;
+            float q = rho2 + t * (two_r_mu + t); // |p|² − R0²
+            q = q > 0.0f ? q : 0.0f;
+            r_end[j] = m.R0 + q / (sqrtf(q + m.R0 * m.R0) + m.R0);
+            c_end[j] = (v.r * cos_view_zenith + t) / r_end[j];
+        }
+        for (int k = 0; k < kResidualSteps; ++k) {
+            const float t = a + (float(k) + 0.5f) * dt;
+            float q = rho2 + t * (two_r_mu + t);
+            q = q > 0.0f ? q : 0.0f;
+            const float hp = q / (sqrtf(q + m.R0 * m.R0) + m.R0);
+            const float rp = m.R0 + hp;
+            const float cos_chi = (v.r * cos_sun_zenith + t * cos_view_sun) / rp;
+            float dens[kMaxTerms], sun[3] = {0.0f, 0.0f, 0.0f};
+            for (int e = 0; e < m.ext_count; ++e) {
+                dens[e] = expf(-hp / m.ext_height[e]);
+                sum_rho[e] += dens[e] * dt;
+                const float view = 0.5f * (dens[e] + prev[e]) * (t - t_prev);
+                const float depth = chapman_depth(rp, m.R0, m.ext_height[e], cos_chi, dens[e]);
+                for (int c = 0; c < 3; ++c) {
+                    tau[c] += m.ext_beta[e][c] * view;
+                    sun[c] += m.ext_beta[e][c] * depth;
+                }
+                prev[e] = dens[e];
+            }
+            t_prev = t;
+            for (int c = 0; c < 3; ++c) {
+                const float tr = expf(-(tau[c] + sun[c])) * dt;
+                for (int k2 = 0; k2 < m.terms; ++k2)
+                    part_sum[3 * k2 + c] += m.term_beta[k2][c] * dens[m.term_ext[k2]] * tr;
+            }
+        }
+        for (int k2 = 0; k2 < m.terms; ++k2) {
+            const int e = m.term_ext[k2];
+            const float H = m.ext_height[e];
+            const float exact = chapman_segment(m.R0, H, r_end[0], c_end[0], expf((m.R0 - r_end[0]) / H), r_end[1],
+                                                c_end[1], expf((m.R0 - r_end[1]) / H));
+            const float scale = sum_rho[e] > 0.0f && exact > 0.0f ? exact / sum_rho[e] : 1.0f;
+            for (int c = 0; c < 3; ++c)
+                base[3 * k2 + c] += scale * part_sum[3 * k2 + c];
+        }
+    }
 }
 
 // Encoded value -> [0, ...): (x − 0.05)/0.9, values below 0.05 are 0.
@@ -159,7 +356,21 @@ SKYBAKE_HD_INLINE float decode_log(float x, float max, float log_range) {
 // Radiance (1/sr) from the encoded outputs.
 //  radiance:       (R, G, B) · N, N from the brightness output M.
 //  phase-factored: Σ_k P_k(cos β0) S_k, each channel of S_k log-encoded.
-SKYBAKE_HD_INLINE glm::vec3 decode_sky(const MlpHD& m, const float* enc, float cos_view_sun = 1.0f) {
+//  residual:       Σ_k P_k(cos β0) A_k exp(R (x_k − 0.5)/0.45), A_k = base[3k..3k+2]
+//                  (analytic_terms; required for residual outputs).
+SKYBAKE_HD_INLINE glm::vec3 decode_sky(const MlpHD& m, const float* enc, float cos_view_sun = 1.0f,
+                                       const float* base = nullptr) {
+    if (m.output_kind == kOutputsResidual) {
+        glm::vec3 c(0.0f);
+        const float scale = kResidualRange / (0.5f * kEncodeScale);
+        for (int k = 0; k < m.terms; ++k) {
+            const float p = sky::phase_value(m.term_phase[k], m.term_g[k], cos_view_sun);
+            c.x += p * base[3 * k + 0] * expf(scale * (enc[3 * k + 0] - 0.5f));
+            c.y += p * base[3 * k + 1] * expf(scale * (enc[3 * k + 1] - 0.5f));
+            c.z += p * base[3 * k + 2] * expf(scale * (enc[3 * k + 2] - 0.5f));
+        }
+        return c;
+    }
     if (m.output_kind == kOutputsPhaseFactored) {
         glm::vec3 c(0.0f);
         for (int k = 0; k < m.terms; ++k) {
@@ -183,6 +394,11 @@ SKYBAKE_HD_INLINE glm::vec3 neural_sky(const MlpHD& m, float cos_view_zenith, fl
     encode_inputs(m, cos_view_zenith, cos_view_sun, cos_sun_zenith, density, in);
     float enc[kMaxOutputs];
     mlp_forward(m, in, enc);
+    if (m.output_kind == kOutputsResidual) {
+        float base[kMaxOutputs];
+        analytic_terms(m, cos_view_zenith, cos_view_sun, cos_sun_zenith, density, base);
+        return decode_sky(m, enc, cos_view_sun, base);
+    }
     return decode_sky(m, enc, cos_view_sun);
 }
 

@@ -100,10 +100,10 @@ void NeuralSky::validate(const std::string& where) const {
     // The network runs in float: max{N} must be a float far from its limits.
     if (!(std::isfinite(encoding.max_n) && encoding.max_n >= 1e-30 && encoding.max_n <= 1e30))
         throw Error("encoding.max_n must be a number in [1e-30, 1e30] (radiance per unit irradiance, 1/sr)", where);
-    if ((encoding.brightness == BrightnessEncoding::Log || encoding.outputs == OutputEncoding::PhaseFactored) &&
+    if ((encoding.brightness == BrightnessEncoding::Log || has_phase_terms(encoding.outputs)) &&
         !(std::isfinite(encoding.log_range) && encoding.log_range > 0.0 && encoding.log_range < 200.0))
         throw Error("encoding.log_range must be in (0, 200) nats", where);
-    if (encoding.outputs == OutputEncoding::PhaseFactored) {
+    if (has_phase_terms(encoding.outputs)) {
         if (encoding.terms.empty() || int(encoding.terms.size()) > neural::kMaxTerms)
             throw Error(fmt::format("phase-factored outputs need 1 to {} terms, not {}", neural::kMaxTerms,
                                     encoding.terms.size()),
@@ -120,6 +120,8 @@ void NeuralSky::validate(const std::string& where) const {
     } else if (!encoding.terms.empty()) {
         throw Error("radiance outputs have no phase terms", where + ": encoding.terms");
     }
+    if (encoding.outputs == OutputEncoding::Residual)
+        neural::check_residual_atmosphere(encoding, atmosphere, where);
     if (topology.outputs != encoding.output_count())
         throw Error(fmt::format("topology.outputs is {} but the {} encoding has {} outputs", topology.outputs,
                                 output_encoding_name(encoding.outputs), encoding.output_count()),
@@ -131,7 +133,7 @@ std::string neural_sky_to_json(const NeuralSky& net) {
     j["format"] = kFormat;
     j["version"] = kVersion;
     const NeuralEncoding& e = net.encoding;
-    const bool factored = e.outputs == OutputEncoding::PhaseFactored;
+    const bool factored = has_phase_terms(e.outputs);
     j["topology"] = {{"name", net.topology.name()},
                      {"kind", net.topology.shared ? "shared" : "independent"},
                      {"hidden", net.topology.hidden},
@@ -140,8 +142,11 @@ std::string neural_sky_to_json(const NeuralSky& net) {
                                            ? "cos_view_zenith, cos_view_sun, cos_sun_zenith, density"
                                            : "view ray length split at the horizon, cos_view_sun, cos_sun_zenith, "
                                              "altitude coordinate"},
-                     {"output_meaning", factored ? "per term, S_r, S_g, S_b (log, each as 0.05 + 0.9 value)"
-                                                 : "R/N, G/N, B/N, M (each as 0.05 + 0.9 value)"},
+                     {"output_meaning",
+                      e.outputs == OutputEncoding::Residual
+                          ? "per term, ln(S/A) for r, g, b (A: the analytic march; each as 0.5 + 0.45 value/2)"
+                      : factored ? "per term, S_r, S_g, S_b (log, each as 0.05 + 0.9 value)"
+                                 : "R/N, G/N, B/N, M (each as 0.05 + 0.9 value)"},
                      {"activation", "1/(1+2^(2x))"},
                      {"weight_count", net.topology.weight_count()}};
     j["encoding"] = {{"inputs", input_encoding_name(e.inputs)},
@@ -262,7 +267,7 @@ NeuralSky neural_sky_from_json(std::string_view text, const std::string& where) 
                             "network with this version",
                             where + ": encoding.inputs");
             net.encoding.outputs = parse_output_encoding(out.get<std::string>(), where + ": encoding.outputs");
-            if (net.encoding.outputs == OutputEncoding::PhaseFactored) {
+            if (has_phase_terms(net.encoding.outputs)) {
                 const json& terms = field(enc, "terms", where + ": encoding");
                 if (!terms.is_array() || terms.empty() || int(terms.size()) > neural::kMaxTerms)
                     throw Error(fmt::format("encoding.terms must be an array of 1 to {} terms", neural::kMaxTerms),
@@ -369,6 +374,7 @@ constexpr NamedValue<InputEncoding> kInputNames[] = {
 constexpr NamedValue<OutputEncoding> kOutputNames[] = {
     {OutputEncoding::Radiance, "radiance", "R/N, G/N, B/N and brightness, as in the seed"},
     {OutputEncoding::PhaseFactored, "phase-factored", "phase-free in-scatter per component, exact phase outside"},
+    {OutputEncoding::Residual, "residual", "phase-factored, as corrections of an analytic few-step march"},
 };
 } // namespace
 

@@ -96,6 +96,16 @@ __device__ __forceinline__ glm::vec3 generic_network(MlpHD m, const float* weigh
     return decode_sky(m, enc, in[1]);
 }
 
+// The same for residual outputs, which need the sample's analytic march.
+__device__ __forceinline__ glm::vec3 residual_network(MlpHD m, const float* weights, const float in[4], float cv,
+                                                      float cvs, float cs, float rho) {
+    m.weights = weights ? weights : c_weights;
+    float enc[kMaxOutputs], base[kMaxOutputs];
+    mlp_forward(m, in, enc);
+    analytic_terms(m, cv, cvs, cs, rho, base);
+    return decode_sky(m, enc, cvs, base);
+}
+
 template <bool Fixed>
 __global__ void neural_kernel(MlpHD m, const float* weights, const SkySample* samples, glm::vec3* out,
                               std::size_t n) {
@@ -105,7 +115,10 @@ __global__ void neural_kernel(MlpHD m, const float* weights, const SkySample* sa
     const SkySample s = samples[i];
     float in[kInputs];
     encode_inputs(m, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, in);
-    out[i] = Fixed ? seed_network(m, in) : generic_network(m, weights, in);
+    if (!Fixed && m.output_kind == kOutputsResidual)
+        out[i] = residual_network(m, weights, in, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density);
+    else
+        out[i] = Fixed ? seed_network(m, in) : generic_network(m, weights, in);
 }
 
 template <bool Fixed>
@@ -116,7 +129,9 @@ __global__ void throughput_kernel(MlpHD m, const float* weights, std::uint64_t n
         float x[4], in[kInputs];
         throughput_inputs(std::uint32_t(i), x);
         encode_inputs(m, x[0], x[1], x[2], x[3], in);
-        const glm::vec3 c = Fixed ? seed_network(m, in) : generic_network(m, weights, in);
+        const glm::vec3 c = !Fixed && m.output_kind == kOutputsResidual
+                                ? residual_network(m, weights, in, x[0], x[1], x[2], x[3])
+                                : Fixed ? seed_network(m, in) : generic_network(m, weights, in);
         acc += c.x + c.y + c.z;
     }
     atomicAdd(checksum, acc);

@@ -72,7 +72,13 @@ TrainingData neural::make_training_data(const SkyModel& model, const NeuralEncod
     MlpHD hd;
     set_encoding_hd(enc, model.atmosphere(), hd);
     d.x = samples_to_matrix(hd, s);
-    if (enc.outputs == OutputEncoding::PhaseFactored) {
+    if (enc.outputs == OutputEncoding::Residual) {
+        std::vector<glm::vec3> split;
+        split_targets(model, s, split, d.radiance);
+        d.base = analytic_matrix(hd, s);
+        encode_residual_targets(split, model.atmosphere().components.size(),
+                                phase_term_components(model.atmosphere()), d.base, d.t, d.mask);
+    } else if (enc.outputs == OutputEncoding::PhaseFactored) {
         std::vector<glm::vec3> split;
         split_targets(model, s, split, d.radiance);
         encode_split_targets(enc, split, model.atmosphere().components.size(),
@@ -134,7 +140,8 @@ ErrorPair evaluate_set(const Layout& lay, const NeuralSky& net, const DataSet& d
                 if (!(n > 0.0f))
                     continue;
                 // Row 1 of the inputs is cos β0 in every input encoding.
-                const glm::vec3 got = decode_sky(hd, enc.col(Eigen::Index(i - lo)).data(), d.x(1, Eigen::Index(i)));
+                const glm::vec3 got = decode_sky(hd, enc.col(Eigen::Index(i - lo)).data(), d.x(1, Eigen::Index(i)),
+                                                 d.base.size() ? d.base.col(Eigen::Index(i)).data() : nullptr);
                 const glm::dvec3 e = glm::dvec3(got) - glm::dvec3(ref);
                 part.rel += std::sqrt(e.x * e.x + e.y * e.y + e.z * e.z) /
                             std::sqrt(double(ref.x) * ref.x + double(ref.y) * ref.y + double(ref.z) * ref.z);
@@ -247,11 +254,11 @@ std::uint64_t neural::stream_seed(std::uint64_t seed, std::uint64_t stream) {
 }
 
 NeuralEncoding neural::make_training_encoding(const SkyModel& model, const NeuralTrainOptions& o) {
-    if ((o.brightness == BrightnessEncoding::Log || o.outputs == OutputEncoding::PhaseFactored) &&
+    if ((o.brightness == BrightnessEncoding::Log || has_phase_terms(o.outputs)) &&
         !(o.log_range > 0.0 && o.log_range < 200.0))
         throw Error("the log range must be in (0, 200) nats", "log_range");
     const std::vector<int> term_components = phase_term_components(model.atmosphere());
-    if (o.outputs == OutputEncoding::PhaseFactored) {
+    if (has_phase_terms(o.outputs)) {
         if (model.atmosphere().scattering != Scattering::Single)
             throw Error("phase-factored outputs are exact for single scattering only; use outputs radiance for an "
                         "atmosphere with multiple scattering",
@@ -271,7 +278,7 @@ NeuralEncoding neural::make_training_encoding(const SkyModel& model, const Neura
     {   // max{N} (and max S_k per channel) over random samples (the seed's 100,000)
         const std::vector<SkySample> s = draw_sky_samples(o.max_n_samples, stream_seed(o.seed, 2));
         std::vector<glm::vec3> r, split;
-        if (o.outputs == OutputEncoding::PhaseFactored) {
+        if (has_phase_terms(o.outputs)) {
             split_targets(model, s, split, r);
             const std::size_t nc = model.atmosphere().components.size();
             for (int k : term_components) {
@@ -296,6 +303,8 @@ NeuralEncoding neural::make_training_encoding(const SkyModel& model, const Neura
                         "atmosphere");
         encoding.max_n = mx;
     }
+    if (o.outputs == OutputEncoding::Residual)
+        check_residual_atmosphere(encoding, model.atmosphere(), "outputs");
     return encoding;
 }
 
@@ -311,7 +320,7 @@ NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, s
         throw Error("the mini-batch must hold 1 to `samples` samples", "batch");
     if (!(o.learning_rate > 0.0 && o.learning_rate_final > 0.0 && o.learning_rate < 10.0))
         throw Error("learning rates must be positive (and below 10)", "learning_rate");
-    if ((o.brightness == BrightnessEncoding::Log || o.outputs == OutputEncoding::PhaseFactored) &&
+    if ((o.brightness == BrightnessEncoding::Log || has_phase_terms(o.outputs)) &&
         !(o.log_range > 0.0 && o.log_range < 200.0))
         throw Error("the log range must be in (0, 200) nats", "log_range");
     const auto t0 = std::chrono::steady_clock::now();
