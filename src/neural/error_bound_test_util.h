@@ -47,7 +47,7 @@ inline NeuralSky with_encoding(NeuralSky net, InputEncoding inputs, OutputEncodi
     net.encoding.outputs = outputs;
     net.encoding.brightness = BrightnessEncoding::Log;
     net.encoding.terms.clear();
-    if (outputs == OutputEncoding::PhaseFactored)
+    if (has_phase_terms(outputs))
         for (int k : neural::phase_term_components(net.atmosphere)) {
             const AtmosphereComponent& c = net.atmosphere.components[std::size_t(k)];
             net.encoding.terms.push_back({c.name, c.phase, c.phase_g, glm::dvec3(2.0, 4.0, 8.0) * double(k + 1)});

@@ -82,13 +82,26 @@ namespace {
 
 // The encoding constants after the weights in the uniform block: max N, the
 // log range, then with horizon inputs R0, Rtop − R0, √(Rtop² − R0²) and the
-// scale height, then per phase term g and max S (r, g, b).
+// scale height; then with residual outputs R0, Rtop − R0, the scale height,
+// per exponential component its scale height and extinction (r, g, b), per
+// term its scattering (r, g, b), and per term g; else per phase term g and
+// max S (r, g, b). This is the order the exporter reads them in.
 std::vector<float> encoding_constants(const NeuralSky& net) {
     const MlpHD m = make_mlp_hd(net);
     std::vector<float> c{m.max_n, m.log_range};
     if (m.inputs == kInputsHorizon) {
         const float top = m.Rtop - m.R0;
         c.insert(c.end(), {m.R0, top, sqrtf(top * (2.0f * m.R0 + top)), m.scale_height});
+    }
+    if (m.output_kind == kOutputsResidual) {
+        c.insert(c.end(), {m.R0, m.Rtop - m.R0, m.scale_height});
+        for (int e = 0; e < m.ext_count; ++e)
+            c.insert(c.end(), {m.ext_height[e], m.ext_beta[e][0], m.ext_beta[e][1], m.ext_beta[e][2]});
+        for (int k = 0; k < m.terms; ++k)
+            c.insert(c.end(), {m.term_beta[k][0], m.term_beta[k][1], m.term_beta[k][2]});
+        for (int k = 0; k < m.terms; ++k)
+            c.push_back(m.term_g[k]);
+        return c;
     }
     for (int k = 0; k < m.terms; ++k)
         c.insert(c.end(), {m.term_g[k], m.term_max[k][0], m.term_max[k][1], m.term_max[k][2]});
@@ -208,6 +221,237 @@ void emit_phase_factored_decoding(std::ostringstream& o, const NeuralSky& net, c
         o << "    rgb[0] = cr;\n    rgb[1] = cg;\n    rgb[2] = cb;\n";
 }
 
+// The residual outputs' helpers, mlp_hd.h's chapman_depth and chapman_segment,
+// written once in GLSL and adapted: float suffixes and C's function names.
+std::string residual_helpers(const std::string& name, const Dialect& d, const std::string& qual,
+                             const std::string& hp) {
+    std::string t = R"(QFLOAT NAME_periapsis(FLOAT h, FLOAT R0, FLOAT cos_chi) {
+    FLOAT s2 = (1.0 - cos_chi) * (1.0 + cos_chi);
+    FLOAT s = sqrt(s2 > 0.0 ? s2 : 0.0);
+    FLOAT h0 = h * s - R0 * (cos_chi * cos_chi) / (1.0 + s);
+    return h0 > 0.0 ? h0 : 0.0;
+}
+
+QFLOAT NAME_depth(FLOAT h, FLOAT R0, FLOAT H, FLOAT cos_chi, FLOAT rho_h) {
+    FLOAT c = sqrt(1.57079633 * (R0 + h) / H);
+    if (cos_chi >= 0.0) return H * rho_h * c / ((c - 1.0) * cos_chi + 1.0);
+    FLOAT h0 = NAME_periapsis(h, R0, cos_chi);
+    FLOAT c0 = sqrt(1.57079633 * (R0 + h0) / H);
+    return H * (2.0 * c0 * exp(-h0 / H) - rho_h * c / ((c - 1.0) * -cos_chi + 1.0));
+}
+
+QFLOAT NAME_segment(FLOAT R0, FLOAT H, FLOAT ha, FLOAT ca, FLOAT rho_a, FLOAT hb, FLOAT cb, FLOAT rho_b) {
+    FLOAT qa = sqrt(1.57079633 * (R0 + ha) / H), qb = sqrt(1.57079633 * (R0 + hb) / H);
+    FLOAT fa = H * rho_a * qa / ((qa - 1.0) * abs(ca) + 1.0);
+    FLOAT fb = H * rho_b * qb / ((qb - 1.0) * abs(cb) + 1.0);
+    if (ca >= 0.0) return fa - fb;
+    if (cb < 0.0) return fb - fa;
+    FLOAT h0 = NAME_periapsis(ha, R0, ca);
+    return 2.0 * H * sqrt(1.57079633 * (R0 + h0) / H) * exp(-h0 / H) - fa - fb;
+}
+
+)";
+    auto replace_all = [&](const std::string& from, const std::string& to) {
+        for (std::size_t at = t.find(from); at != std::string::npos; at = t.find(from, at + to.size()))
+            t.replace(at, from.size(), to);
+    };
+    replace_all("QFLOAT", qual + hp + "float");
+    replace_all("FLOAT", hp + "float");
+    replace_all("NAME", name);
+    if (!d.shader) {
+        replace_all("sqrt(", "sqrtf(");
+        replace_all("exp(", "expf(");
+        replace_all("abs(", "fabsf(");
+    }
+    if (*d.suffix) // float literals (digits '.' digits) take the suffix
+        for (std::size_t i = 1; i + 1 < t.size(); ++i)
+            if (t[i] == '.' && std::isdigit(static_cast<unsigned char>(t[i - 1])) &&
+                std::isdigit(static_cast<unsigned char>(t[i + 1]))) {
+                std::size_t j = i + 1;
+                while (j < t.size() && std::isdigit(static_cast<unsigned char>(t[j])))
+                    ++j;
+                t.insert(j, d.suffix);
+                i = j;
+            }
+    return t;
+}
+
+// mlp_hd.h's analytic_terms, operation for operation, into A<k>r, A<k>g, A<k>b.
+void emit_analytic_terms(std::ostringstream& o, const std::string& name, const MlpHD& m, const Dialect& d,
+                         const Constant& constant) {
+    const std::string R0 = constant(m.R0), top = constant(m.Rtop - m.R0), scale = constant(m.scale_height);
+    std::vector<std::string> H(std::size_t(m.ext_count)), be(std::size_t(3 * m.ext_count)),
+        bs(std::size_t(3 * m.terms));
+    for (int e = 0; e < m.ext_count; ++e) {
+        H[std::size_t(e)] = constant(m.ext_height[e]);
+        for (int c = 0; c < 3; ++c)
+            be[std::size_t(3 * e + c)] = constant(m.ext_beta[e][c]);
+    }
+    for (int k = 0; k < m.terms; ++k)
+        for (int c = 0; c < 3; ++c)
+            bs[std::size_t(3 * k + c)] = constant(m.term_beta[k][c]);
+    const std::string zero = lit(0.0f, d), one = lit(1.0f, d), two = lit(2.0f, d), half = lit(0.5f, d);
+    const std::string sqrt_ = d.shader ? "sqrt" : "sqrtf", log_ = d.shader ? "log" : "logf";
+    const std::string exp_ = d.exp, abs_ = d.shader ? "abs" : "fabsf";
+    const char* ch = "rgb";
+    o << "    // residual outputs: the analytic single scattering A per term (skybake's analytic_terms)\n";
+    o << fmt::format("    float a_u = (density - {0}) / (density + {0}), a_u2 = a_u * a_u;\n", one);
+    o << fmt::format("    float a_h = -{} * (density > {} ? {} * a_u * ({} + a_u2 * ({} + a_u2 * {})) : {}(density));\n",
+                     scale, lit(0.97f, d), two, one, lit(0.333333343f, d), lit(0.2f, d), log_);
+    o << fmt::format("    a_h = a_h > {0} ? (a_h < {1} ? a_h : {1}) : {0};\n", zero, top);
+    o << fmt::format("    float a_r = {} + a_h;\n", R0);
+    o << fmt::format("    float a_rho = {}(a_h * ({} * {} + a_h));\n", sqrt_, two, R0);
+    o << "    float a_rc = a_r * cos_view_zenith;\n";
+    o << fmt::format("    float a_arc = {}(a_rc);\n", abs_);
+    o << "    float a_d;\n";
+    o << fmt::format("    if (cos_view_zenith < {} && a_arc >= a_rho) {{\n", zero);
+    o << "        float disc = (a_arc - a_rho) * (a_arc + a_rho);\n";
+    o << fmt::format("        a_d = a_rho * a_rho / (a_arc + {}(disc > {} ? disc : {}));\n", sqrt_, zero, zero);
+    o << "    } else {\n";
+    o << fmt::format("        float k = ({} - a_h) * ({} * {} + {} + a_h);\n", top, two, R0, top);
+    o << "        float disc = a_rc * a_rc + k;\n";
+    o << fmt::format("        float s = {}(disc > {} ? disc : {});\n", sqrt_, zero, zero);
+    o << fmt::format("        a_d = a_rc > {} ? k / (a_rc + s) : -a_rc + s;\n", zero);
+    o << "    }\n";
+    o << "    // the planet's shadow on the ray: [a_lo, a_hi]\n";
+    o << fmt::format("    float a_lo = {}, a_hi = a_d;\n", zero);
+    o << "    float a_c = a_r * cos_sun_zenith;\n";
+    o << "    bool a_sh = true;\n";
+    o << fmt::format("    if (cos_view_sun > {0}) {{ float t = -a_c / cos_view_sun; a_hi = a_hi < t ? a_hi : t; }}\n"
+                     "    else if (cos_view_sun < {0}) {{ float t = -a_c / cos_view_sun; a_lo = a_lo > t ? a_lo : t; }}\n"
+                     "    else a_sh = a_c < {0};\n",
+                     zero);
+    o << fmt::format("    float a_A = ({0} - cos_view_sun) * ({0} + cos_view_sun);\n", one);
+    o << fmt::format("    float a_B = {} * a_r * (cos_view_zenith - cos_sun_zenith * cos_view_sun);\n", two);
+    o << "    float a_C = (a_rho - a_c) * (a_rho + a_c);\n";
+    o << fmt::format("    if (a_A <= {}) {{\n", lit(1e-12f, d));
+    o << fmt::format("        if (a_B > {0}) {{ float t = -a_C / a_B; a_hi = a_hi < t ? a_hi : t; }}\n"
+                     "        else if (a_B < {0}) {{ float t = -a_C / a_B; a_lo = a_lo > t ? a_lo : t; }}\n"
+                     "        else a_sh = a_sh && a_C < {0};\n",
+                     zero);
+    o << "    } else {\n";
+    o << fmt::format("        float D = a_B * a_B - {} * a_A * a_C;\n", lit(4.0f, d));
+    o << fmt::format("        if (D > {}) {{\n", zero);
+    o << fmt::format("            float sq = {}(D);\n", sqrt_);
+    o << fmt::format("            float q = -{} * (a_B + (a_B < {} ? -sq : sq));\n", half, zero);
+    o << fmt::format("            float ta = q / a_A, tb = q != {} ? a_C / q : -ta;\n", zero);
+    o << "            float t0 = ta < tb ? ta : tb, t1 = ta < tb ? tb : ta;\n";
+    o << "            a_lo = a_lo > t0 ? a_lo : t0;\n";
+    o << "            a_hi = a_hi < t1 ? a_hi : t1;\n";
+    o << "        } else {\n            a_sh = false;\n        }\n";
+    o << "    }\n";
+    o << "    a_sh = a_sh && a_lo < a_hi;\n";
+    o << "    // the march over the lit parts\n";
+    o << fmt::format("    float a_rho2 = a_rho * a_rho, a_2rmu = {} * a_r * cos_view_zenith;\n", two);
+    o << fmt::format("    float tau_r = {0}, tau_g = {0}, tau_b = {0}, t_prev = {0};\n", zero);
+    for (int e = 0; e < m.ext_count; ++e)
+        o << fmt::format("    float prev{} = {}(-a_h / {});\n", e, exp_, H[std::size_t(e)]);
+    for (int k = 0; k < m.terms; ++k)
+        o << fmt::format("    float A{0}r = {1}, A{0}g = {1}, A{0}b = {1};\n", k, zero);
+    o << "    for (int part = 0; part < 2; ++part) {\n";
+    o << fmt::format("        float a = part == 0 ? {} : (a_sh ? a_hi : a_d);\n", zero);
+    o << "        float b = part == 0 ? (a_sh ? a_lo : a_d) : a_d;\n";
+    o << "        if (!(b > a)) continue;\n";
+    o << fmt::format("        float dt = (b - a) * {};\n", lit(1.0f / float(kResidualSteps), d));
+    o << "        float h_end0, h_end1, h_end2, r_end0, c_end0, r_end1, c_end1;\n";
+    for (int j = 0; j < 3; ++j) {
+        o << "        {\n";
+        if (j == 2)
+            o << "            float t = -a_r * cos_view_zenith;\n            t = t < a ? a : (t > b ? b : t);\n";
+        else
+            o << fmt::format("            float t = {};\n", j == 0 ? "a" : "b");
+        o << "            float q = a_rho2 + t * (a_2rmu + t);\n";
+        o << fmt::format("            q = q > {0} ? q : {0};\n", zero);
+        o << fmt::format("            h_end{0} = q / ({1}(q + {2} * {2}) + {2});\n", j, sqrt_, R0);
+        if (j < 2) {
+            o << fmt::format("            r_end{0} = {1} + h_end{0};\n", j, R0);
+            o << fmt::format("            c_end{0} = (a_r * cos_view_zenith + t) / r_end{0};\n", j);
+        }
+        o << "        }\n";
+    }
+    for (int e = 0; e < m.ext_count; ++e)
+        o << fmt::format("        float sum{} = {};\n", e, zero);
+    for (int k = 0; k < m.terms; ++k)
+        o << fmt::format("        float P{0}r = {1}, P{0}g = {1}, P{0}b = {1};\n", k, zero);
+    o << fmt::format("        float fk = {};\n", half);
+    o << fmt::format("        for (int k = 0; k < {}; ++k) {{\n", kResidualSteps);
+    o << "            float t = a + fk * dt;\n";
+    o << fmt::format("            fk += {};\n", one);
+    o << "            float q = a_rho2 + t * (a_2rmu + t);\n";
+    o << fmt::format("            q = q > {0} ? q : {0};\n", zero);
+    o << fmt::format("            float hp = q / ({0}(q + {1} * {1}) + {1});\n", sqrt_, R0);
+    o << fmt::format("            float rp = {} + hp;\n", R0);
+    o << "            float cos_chi = (a_r * cos_sun_zenith + t * cos_view_sun) / rp;\n";
+    o << fmt::format("            float sun_r = {0}, sun_g = {0}, sun_b = {0};\n", zero);
+    for (int e = 0; e < m.ext_count; ++e) {
+        o << fmt::format("            float dens{} = {}(-hp / {});\n", e, exp_, H[std::size_t(e)]);
+        o << fmt::format("            sum{0} += dens{0} * dt;\n", e);
+        o << "            {\n";
+        o << fmt::format("                float view = {0} * (dens{1} + prev{1}) * (t - t_prev);\n", half, e);
+        o << fmt::format("                float depth = {}_depth(hp, {}, {}, cos_chi, dens{});\n", name, R0,
+                         H[std::size_t(e)], e);
+        for (int c = 0; c < 3; ++c)
+            o << fmt::format("                tau_{0} += {1} * view;\n                sun_{0} += {1} * depth;\n",
+                             ch[c], be[std::size_t(3 * e + c)]);
+        o << "            }\n";
+        o << fmt::format("            prev{0} = dens{0};\n", e);
+    }
+    o << "            t_prev = t;\n";
+    for (int c = 0; c < 3; ++c) {
+        o << "            {\n";
+        o << fmt::format("                float tr = {0}(-(tau_{1} + sun_{1})) * dt;\n", exp_, ch[c]);
+        for (int k = 0; k < m.terms; ++k)
+            o << fmt::format("                P{}{} += {} * dens{} * tr;\n", k, ch[c], bs[std::size_t(3 * k + c)],
+                             m.term_ext[k]);
+        o << "            }\n";
+    }
+    o << "        }\n";
+    for (int k = 0; k < m.terms; ++k) {
+        const int e = m.term_ext[k];
+        o << "        {\n";
+        o << fmt::format("            float exact = {0}_segment({1}, {2}, h_end0, c_end0, {3}(-h_end0 / {2}), "
+                         "h_end1, c_end1, {3}(-h_end1 / {2}));\n",
+                         name, R0, H[std::size_t(e)], exp_);
+        o << fmt::format("            float g = (h_end0 + h_end1 - {} * h_end2) / {};\n", two, H[std::size_t(e)]);
+        o << fmt::format("            float w = (g - {0}) * {0};\n", half);
+        o << fmt::format("            w = w > {0} ? (w < {1} ? w : {1}) : {0};\n", zero, one);
+        o << fmt::format("            w = w * w * ({} - {} * w);\n", lit(3.0f, d), two);
+        o << fmt::format("            float ratio = sum{0} > {1} && exact > {1} ? exact / sum{0} : {2};\n", e, zero,
+                         one);
+        o << fmt::format("            float sc = {0} + w * (ratio - {0});\n", one);
+        for (int c = 0; c < 3; ++c)
+            o << fmt::format("            A{0}{1} += sc * P{0}{1};\n", k, ch[c]);
+        o << "        }\n";
+    }
+    o << "    }\n";
+}
+
+// I = Σ_k P_k(cos b0) A_k exp(R (x − 0.5)/0.45) per channel.
+void emit_residual_decoding(std::ostringstream& o, const NeuralSky& net, const MlpHD& m, const Dialect& d,
+                            const std::vector<std::string>& outputs, const Constant& constant) {
+    const std::string zero = lit(0.0f, d), half = lit(0.5f, d);
+    const std::string scale = lit(kResidualRange / (0.5f * kEncodeScale), d);
+    o << "    // decoding: per phase term, the exact phase function times A as the network corrects it\n";
+    o << fmt::format("    float cr = {0}, cg = {0}, cb = {0};\n", zero);
+    const char* acc[] = {"cr", "cg", "cb"};
+    const char* ch = "rgb";
+    for (int k = 0; k < m.terms; ++k) {
+        const std::string g = constant(m.term_g[k]);
+        const bool lit_g = g.find('[') == std::string::npos;
+        o << fmt::format("    {{ // {} ({})\n", net.encoding.terms[std::size_t(k)].component,
+                         phase_function_name(net.encoding.terms[std::size_t(k)].phase));
+        o << fmt::format("        float p = {};\n", phase_expression(m.term_phase[k], g, m.term_g[k], lit_g, d));
+        for (int c = 0; c < 3; ++c)
+            o << fmt::format("        {} += p * A{}{} * {}({} * ({} - {}));\n", acc[c], k, ch[c], d.exp, scale,
+                             outputs[std::size_t(3 * k + c)], half);
+        o << "    }\n";
+    }
+    if (d.shader)
+        o << fmt::format("    return {}(cr, cg, cb);\n", d.vec3);
+    else
+        o << "    rgb[0] = cr;\n    rgb[1] = cg;\n    rgb[2] = cb;\n";
+}
+
 } // namespace
 
 std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const ShaderExportOptions& options) {
@@ -260,7 +504,7 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const S
     const char* qual = "";
     switch (lang) {
     case ExportLanguage::C:
-        o << "#include <math.h>\n\n";
+        o << (m.output_kind == kOutputsResidual ? "#include <math.h>\n#include <stdbool.h>\n\n" : "#include <math.h>\n\n");
         qual = "static ";
         break;
     case ExportLanguage::Cuda:
@@ -284,6 +528,8 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const S
     // Activation f(x) = 1/(1 + 2^(2x)).
     o << fmt::format("{}{}float {}({}float x) {{ return {} / ({} + {}({} * x)); }}\n\n", qual, hp, f, hp,
                      lit(1.0f, d), lit(1.0f, d), d.exp2, lit(2.0f, d));
+    if (m.output_kind == kOutputsResidual)
+        o << residual_helpers(name, d, qual, hp);
     const std::string params = fmt::format("{0}float cos_view_zenith, {0}float cos_view_sun, {0}float cos_sun_zenith, "
                                            "{0}float density",
                                            hp);
@@ -304,7 +550,7 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const S
     else
         o << "    " << cst << "float in0 = cos_view_zenith, in1 = cos_view_sun, in2 = cos_sun_zenith, in3 = density;\n";
     std::vector<std::string> out_names{"R", "G", "B", "M"};
-    if (m.output_kind == kOutputsPhaseFactored) {
+    if (m.output_kind != kOutputsRadiance) {
         out_names.clear();
         for (const PhaseTerm& t : net.encoding.terms)
             for (const char* c : {"r", "g", "b"})
@@ -349,6 +595,12 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const S
             outputs.push_back(v);
     }
     const std::string inv = lit(1.0f / kEncodeScale, d), off = lit(kEncodeOffset, d), zero = lit(0.0f, d);
+    if (m.output_kind == kOutputsResidual) {
+        emit_analytic_terms(o, name, m, d, constant);
+        emit_residual_decoding(o, net, m, d, outputs, constant);
+        o << "}\n";
+        return o.str();
+    }
     if (m.output_kind == kOutputsPhaseFactored) {
         emit_phase_factored_decoding(o, net, m, d, outputs, log_range, constant);
         o << "}\n";

@@ -63,6 +63,8 @@ constexpr Encoding kNewEncodings[] = {
     {InputEncoding::Horizon, OutputEncoding::Radiance, "horizon/radiance"},
     {InputEncoding::Seed, OutputEncoding::PhaseFactored, "seed/phase-factored"},
     {InputEncoding::Horizon, OutputEncoding::PhaseFactored, "horizon/phase-factored"},
+    {InputEncoding::Seed, OutputEncoding::Residual, "seed/residual"},
+    {InputEncoding::Horizon, OutputEncoding::Residual, "horizon/residual"},
 };
 
 // Every network the tests below export: two topologies, both brightness codes

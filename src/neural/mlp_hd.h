@@ -113,10 +113,9 @@ struct ViewRayHD {
     float h, r, rho, d;
     bool ground;
 };
-SKYBAKE_HD_INLINE ViewRayHD view_ray(const MlpHD& m, float cos_view_zenith, float density) {
+SKYBAKE_HD_INLINE ViewRayHD view_ray_at(const MlpHD& m, float cos_view_zenith, float h) {
     ViewRayHD v;
     const float top = m.Rtop - m.R0;
-    float h = -m.scale_height * logf(density);
     v.h = h > 0.0f ? (h < top ? h : top) : 0.0f;
     v.r = m.R0 + v.h;
     v.rho = sqrtf(v.h * (2.0f * m.R0 + v.h)); // √(r² − R0²)
@@ -131,6 +130,18 @@ SKYBAKE_HD_INLINE ViewRayHD view_ray(const MlpHD& m, float cos_view_zenith, floa
         v.d = -rc + sqrtf(disc > 0.0f ? disc : 0.0f);
     }
     return v;
+}
+SKYBAKE_HD_INLINE ViewRayHD view_ray(const MlpHD& m, float cos_view_zenith, float density) {
+    return view_ray_at(m, cos_view_zenith, -m.scale_height * logf(density));
+}
+
+// ln x with relative accuracy near 1 as well: 2 atanh((x − 1)/(x + 1)) by
+// its series there (GLSL's log is only accurate to 2⁻²¹ absolute on [0.5, 2],
+// which is a relative error of 1e-3 in the altitude of an observer a few
+// metres above the ground, and in the length of its short rays down).
+SKYBAKE_HD_INLINE float log_density(float x) {
+    const float u = (x - 1.0f) / (x + 1.0f), u2 = u * u;
+    return x > 0.97f ? 2.0f * u * (1.0f + u2 * (0.333333343f + u2 * 0.2f)) : logf(x);
 }
 
 // The network's inputs from the sky function's arguments.
@@ -237,27 +248,35 @@ SKYBAKE_HD_INLINE bool shadow_span(float r, float rho, float mu, float nu, float
     return lo < hi;
 }
 
-// ∫ ρ ds (km) from radius r towards cos χ to infinity, ρ = exp(−(r − R0)/H)
-// given as rho_r (the Chapman estimate above).
-SKYBAKE_HD_INLINE float chapman_depth(float r, float R0, float H, float cos_chi, float rho_r) {
-    const float c = sqrtf(1.57079632679f * r / H);
-    if (cos_chi >= 0.0f)
-        return H * rho_r * c / ((c - 1.0f) * cos_chi + 1.0f);
+// The altitude of the periapsis of a ray from altitude h at cos χ < 0 to
+// the zenith: (R0 + h) sin χ − R0, as h sin χ − R0 cos²χ/(1 + sin χ), which
+// keeps float's digits (the first form is a difference of two 6,000 km
+// numbers); at least 0.
+SKYBAKE_HD_INLINE float periapsis_altitude(float h, float R0, float cos_chi) {
     const float s2 = (1.0f - cos_chi) * (1.0f + cos_chi);
-    float x0 = r * sqrtf(s2 > 0.0f ? s2 : 0.0f);
-    x0 = x0 > R0 ? x0 : R0;
-    const float c0 = sqrtf(1.57079632679f * x0 / H);
-    return H * (2.0f * c0 * expf((R0 - x0) / H) - rho_r * c / ((c - 1.0f) * -cos_chi + 1.0f));
+    const float s = sqrtf(s2 > 0.0f ? s2 : 0.0f);
+    const float h0 = h * s - R0 * (cos_chi * cos_chi) / (1.0f + s);
+    return h0 > 0.0f ? h0 : 0.0f;
 }
 
-// ∫ ρ dt over [a, b] of the view ray from radius r, cos zenith μ, for an
-// exponential component of scale height H: differences of chapman_depth at
-// the ends, with the periapsis term (where the ray passes it) counted once.
-// The view's cosine (r μ + t)/|p(t)| only grows along the ray.
-SKYBAKE_HD_INLINE float chapman_segment(float R0, float H, float ra, float ca, float rho_a, float rb, float cb,
+// ∫ ρ ds (km) from altitude h towards cos χ to infinity, ρ = exp(−h/H) given
+// as rho_h (the Chapman estimate above).
+SKYBAKE_HD_INLINE float chapman_depth(float h, float R0, float H, float cos_chi, float rho_h) {
+    const float c = sqrtf(1.57079632679f * (R0 + h) / H);
+    if (cos_chi >= 0.0f)
+        return H * rho_h * c / ((c - 1.0f) * cos_chi + 1.0f);
+    const float h0 = periapsis_altitude(h, R0, cos_chi);
+    const float c0 = sqrtf(1.57079632679f * (R0 + h0) / H);
+    return H * (2.0f * c0 * expf(-h0 / H) - rho_h * c / ((c - 1.0f) * -cos_chi + 1.0f));
+}
+
+// ∫ ρ dt over a part [a, b] of a view ray, for an exponential component of
+// scale height H, from the altitudes and view cosines at its ends:
+// differences of chapman_depth, with the periapsis term (where the part
+// passes it) counted once. The view's cosine only grows along the ray.
+SKYBAKE_HD_INLINE float chapman_segment(float R0, float H, float ha, float ca, float rho_a, float hb, float cb,
                                         float rho_b) {
-    const float xa = 1.57079632679f * ra / H, xb = 1.57079632679f * rb / H;
-    const float qa = sqrtf(xa), qb = sqrtf(xb);
+    const float qa = sqrtf(1.57079632679f * (R0 + ha) / H), qb = sqrtf(1.57079632679f * (R0 + hb) / H);
     // Ch(x, |cos|) ρ H at each end: forward depth above the horizon, backward below.
     const float fa = H * rho_a * qa / ((qa - 1.0f) * fabsf(ca) + 1.0f);
     const float fb = H * rho_b * qb / ((qb - 1.0f) * fabsf(cb) + 1.0f);
@@ -265,23 +284,34 @@ SKYBAKE_HD_INLINE float chapman_segment(float R0, float H, float ra, float ca, f
         return fa - fb; // both ends above their horizons: forward(a) − forward(b)
     if (cb < 0.0f)
         return fb - fa; // both below: backward(b) − backward(a)
-    // Through the periapsis x0 = r sin χ: 2 ρ(x0) H Ch(x0, 0) − backward(a) − forward(b).
-    const float s2 = (1.0f - ca) * (1.0f + ca);
-    float x0 = ra * sqrtf(s2 > 0.0f ? s2 : 0.0f);
-    x0 = x0 > R0 ? x0 : R0;
-    return 2.0f * H * sqrtf(1.57079632679f * x0 / H) * expf((R0 - x0) / H) - fa - fb;
+    // Through the periapsis: 2 ρ(h0) H Ch(x0, 0) − backward(a) − forward(b).
+    const float h0 = periapsis_altitude(ha, R0, ca);
+    return 2.0f * H * sqrtf(1.57079632679f * (R0 + h0) / H) * expf(-h0 / H) - fa - fb;
 }
 
 // The analytic single scattering A per phase term and channel (1/sr per unit
 // sun irradiance, without the phase function) into base[3 k + c]. In each lit
 // part the midpoint sum of each component's density is scaled to its
-// Chapman integral (chapman_segment), so that a steep profile (aerosols, a
-// 1.2 km scale height, on a 100 km ray) is not lost between the steps.
+// Chapman integral (chapman_segment) where the part spans scale heights, so
+// that a steep profile (aerosols, a 1.2 km scale height, on a 100 km ray) is
+// not lost between the steps.
 SKYBAKE_HD_INLINE void analytic_terms(const MlpHD& m, float cos_view_zenith, float cos_view_sun, float cos_sun_zenith,
                                       float density, float* base) {
     for (int i = 0; i < 3 * m.terms; ++i)
         base[i] = 0.0f;
-    const ViewRayHD v = view_ray(m, cos_view_zenith, density);
+    ViewRayHD v = view_ray_at(m, cos_view_zenith, -m.scale_height * log_density(density));
+    {   // The ray's length without view_ray's cancellation (a short ray to the
+        // ground, or up from near the top): the root's other form.
+        const float rc = v.r * cos_view_zenith, arc = fabsf(rc), top = m.Rtop - m.R0;
+        if (v.ground) {
+            const float disc = (arc - v.rho) * (arc + v.rho);
+            v.d = v.rho * v.rho / (arc + sqrtf(disc > 0.0f ? disc : 0.0f));
+        } else if (rc > 0.0f) {
+            const float k = (top - v.h) * (2.0f * m.R0 + top + v.h); // Rtop² − r²
+            const float disc = rc * rc + k;
+            v.d = k / (rc + sqrtf(disc > 0.0f ? disc : 0.0f));
+        }
+    }
     float lo, hi;
     const bool shadow = shadow_span(v.r, v.rho, cos_view_zenith, cos_view_sun, cos_sun_zenith, v.d, lo, hi);
     const float rho2 = v.rho * v.rho, two_r_mu = 2.0f * v.r * cos_view_zenith;
@@ -295,13 +325,21 @@ SKYBAKE_HD_INLINE void analytic_terms(const MlpHD& m, float cos_view_zenith, flo
             continue;
         const float dt = (b - a) * (1.0f / float(kResidualSteps));
         float sum_rho[kMaxTerms] = {}, part_sum[kMaxOutputs] = {};
-        float r_end[2], c_end[2];
-        for (int j = 0; j < 2; ++j) {
-            const float t = j == 0 ? a : b;
+        // The part's ends (altitude, radius, view cosine) and its lowest altitude.
+        float h_end[3], r_end[2], c_end[2];
+        for (int j = 0; j < 3; ++j) {
+            float t = j == 0 ? a : b;
+            if (j == 2) { // where the ray passes closest to the centre, clamped to the part
+                t = -v.r * cos_view_zenith;
+                t = t < a ? a : (t > b ? b : t);
+            }
             float q = rho2 + t * (two_r_mu + t); // |p|² − R0²
             q = q > 0.0f ? q : 0.0f;
-            r_end[j] = m.R0 + q / (sqrtf(q + m.R0 * m.R0) + m.R0);
-            c_end[j] = (v.r * cos_view_zenith + t) / r_end[j];
+            h_end[j] = q / (sqrtf(q + m.R0 * m.R0) + m.R0);
+            if (j < 2) {
+                r_end[j] = m.R0 + h_end[j];
+                c_end[j] = (v.r * cos_view_zenith + t) / r_end[j];
+            }
         }
         for (int k = 0; k < kResidualSteps; ++k) {
             const float t = a + (float(k) + 0.5f) * dt;
@@ -315,7 +353,7 @@ SKYBAKE_HD_INLINE void analytic_terms(const MlpHD& m, float cos_view_zenith, flo
                 dens[e] = expf(-hp / m.ext_height[e]);
                 sum_rho[e] += dens[e] * dt;
                 const float view = 0.5f * (dens[e] + prev[e]) * (t - t_prev);
-                const float depth = chapman_depth(rp, m.R0, m.ext_height[e], cos_chi, dens[e]);
+                const float depth = chapman_depth(hp, m.R0, m.ext_height[e], cos_chi, dens[e]);
                 for (int c = 0; c < 3; ++c) {
                     tau[c] += m.ext_beta[e][c] * view;
                     sun[c] += m.ext_beta[e][c] * depth;
@@ -332,9 +370,19 @@ SKYBAKE_HD_INLINE void analytic_terms(const MlpHD& m, float cos_view_zenith, flo
         for (int k2 = 0; k2 < m.terms; ++k2) {
             const int e = m.term_ext[k2];
             const float H = m.ext_height[e];
-            const float exact = chapman_segment(m.R0, H, r_end[0], c_end[0], expf((m.R0 - r_end[0]) / H), r_end[1],
-                                                c_end[1], expf((m.R0 - r_end[1]) / H));
-            const float scale = sum_rho[e] > 0.0f && exact > 0.0f ? exact / sum_rho[e] : 1.0f;
+            const float exact = chapman_segment(m.R0, H, h_end[0], c_end[0], expf(-h_end[0] / H), h_end[1], c_end[1],
+                                                expf(-h_end[1] / H));
+            // The Chapman integral where the part spans scale heights (the
+            // steps miss the density's peak), the steps' sum where it spans
+            // little (the steps are exact, and the integral, a difference of
+            // two depths, is all rounding): g, the scale heights the density
+            // climbs and falls along the part, blends them between 0.5 and 2.5.
+            const float g = (h_end[0] + h_end[1] - 2.0f * h_end[2]) / H;
+            float w = (g - 0.5f) * 0.5f;
+            w = w > 0.0f ? (w < 1.0f ? w : 1.0f) : 0.0f;
+            w = w * w * (3.0f - 2.0f * w);
+            const float ratio = sum_rho[e] > 0.0f && exact > 0.0f ? exact / sum_rho[e] : 1.0f;
+            const float scale = 1.0f + w * (ratio - 1.0f);
             for (int c = 0; c < 3; ++c)
                 base[3 * k2 + c] += scale * part_sum[3 * k2 + c];
         }
