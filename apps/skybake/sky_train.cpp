@@ -38,9 +38,10 @@ void add_sky_train(CLI::App& group) {
                     "(the four cosines and density as they are)")
         ->capture_default_str();
     sub->add_option("--outputs", o->outputs,
-                    "Network outputs: phase-factored (in-scatter per component, exact phase functions outside; "
-                    "single scattering) or radiance (R/N, G/N, B/N and brightness, as in the seed); default "
-                    "phase-factored, radiance for an atmosphere with multiple scattering");
+                    "Network outputs: residual (corrections of an analytic few-step march, per component; single "
+                    "scattering), phase-factored (in-scatter per component, exact phase functions outside; single "
+                    "scattering) or radiance (R/N, G/N, B/N and brightness, as in the seed); default residual, "
+                    "radiance for an atmosphere with multiple scattering");
     sub->add_option("--brightness", o->brightness,
                     "Brightness output M: log (relative accuracy) or linear (as printed; also: seed)")
         ->capture_default_str();
@@ -103,8 +104,7 @@ void add_sky_train(CLI::App& group) {
                                              output_encoding_name(o->t.outputs)),
                                  "--outputs");
         } else
-            o->t.outputs = atm.scattering == Scattering::Single ? OutputEncoding::PhaseFactored
-                                                                : OutputEncoding::Radiance;
+            o->t.outputs = default_output_encoding(atm);
         o->t.log_range = o->log_range_decades * std::log(10.0);
         if (!given(*sub, "--batch"))
             o->t.batch = std::min<std::size_t>(o->t.batch, o->t.samples);

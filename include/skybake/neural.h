@@ -113,6 +113,10 @@ enum class InputEncoding : int { Seed = 0, Horizon = 1 };
 enum class OutputEncoding : int { Radiance = 0, PhaseFactored = 1, Residual = 2 };
 // Phase-factored and residual outputs: one term per scattering component.
 inline bool has_phase_terms(OutputEncoding e) { return e != OutputEncoding::Radiance; }
+// The outputs `sky train` and train_sky() choose when none are asked for:
+// residual for single scattering (phase-factored where a scattering
+// component is not exponential), radiance with multiple scattering.
+OutputEncoding default_output_encoding(const Atmosphere& atmosphere);
 const char* input_encoding_name(InputEncoding encoding);
 const char* output_encoding_name(OutputEncoding encoding);
 InputEncoding parse_input_encoding(const std::string& text, const std::string& where = "inputs");

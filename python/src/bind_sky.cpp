@@ -100,7 +100,7 @@ void bind_sky(py::module_& m) {
             "Input encoding: 'seed' or 'horizon'.")
         .def_property_readonly(
             "outputs", [](const NeuralSky& n) { return std::string(output_encoding_name(n.encoding.outputs)); },
-            "Output encoding: 'radiance' or 'phase-factored'.")
+            "Output encoding: 'radiance', 'phase-factored' or 'residual'.")
         .def_property_readonly(
             "weights",
             [](const NeuralSky& n) {
@@ -243,11 +243,8 @@ void bind_sky(py::module_& m) {
             o.seed = seed;
             o.brightness = parse_brightness_encoding(brightness, "brightness");
             o.inputs = parse_input_encoding(inputs, "inputs");
-            // As `sky train`: phase-factored outputs unless the sky has multiple
-            // scattering, for which they are not exact (train_neural_sky refuses them).
-            o.outputs = outputs ? parse_output_encoding(*outputs, "outputs")
-                                : atmosphere.scattering == Scattering::Single ? OutputEncoding::PhaseFactored
-                                                                              : OutputEncoding::Radiance;
+            // As `sky train`: default_output_encoding (residual for single scattering).
+            o.outputs = outputs ? parse_output_encoding(*outputs, "outputs") : default_output_encoding(atmosphere);
             o.device = parse_device(device);
             o.progress = true; // events go to the call's callback, never to a bar
             if (samples < 1000)
@@ -268,7 +265,7 @@ void bind_sky(py::module_& m) {
         py::arg("brightness") = "log", py::arg("table_rule") = "refined", py::arg("steps") = kTrainingTargetSteps,
         py::arg("device") = "cpu", py::arg("progress") = py::none(),
         "Trains a network on the table path of `atmosphere` (Adam, then Levenberg–Marquardt), as "
-        "`skybake sky train`: by default the best small network (shared:16x12, horizon inputs, phase-factored "
+        "`skybake sky train`: by default the best small network (shared:16x12, horizon inputs, residual "
         "outputs; radiance outputs with multiple scattering), targets from the refined 512 x 256 tables with 64 "
         "steps. The seed's network: topology='paper', inputs='seed', outputs='radiance', brightness='linear' "
         "(and table_rule='as-published', steps=16 for its targets). Deterministic for a seed. "

@@ -85,9 +85,9 @@ def test_training_is_deterministic(earth, tiny_net):
     events = []
     default = skybake.train_sky(earth, samples=2000, adam_epochs=1, lm_iterations=0, progress=events.append)
     assert events and events[-1].finished
-    # The default: the best small network, horizon inputs and phase-factored
+    # The default: the best small network, horizon inputs and residual
     # outputs (Rayleigh and Mie, three channels each).
-    assert (default.topology, default.inputs, default.outputs) == ("shared:16x12", "horizon", "phase-factored")
+    assert (default.topology, default.inputs, default.outputs) == ("shared:16x12", "horizon", "residual")
     assert default.weight_count == (4 + 1) * 16 + (16 + 1) * 12 + (12 + 1) * 6
     with pytest.raises(skybake.Error, match="outputs"):
         skybake.train_sky(earth, outputs="spectral", samples=2000, adam_epochs=1, lm_iterations=0)

@@ -247,6 +247,21 @@ NormalPart normal_equations(const Layout& lay, const std::vector<float>& w, int 
 
 } // namespace
 
+OutputEncoding default_output_encoding(const Atmosphere& atmosphere) {
+    if (atmosphere.scattering != Scattering::Single)
+        return OutputEncoding::Radiance;
+    NeuralEncoding e;
+    e.outputs = OutputEncoding::Residual;
+    for (int k : phase_term_components(atmosphere))
+        e.terms.push_back({atmosphere.components[std::size_t(k)].name});
+    try {
+        check_residual_atmosphere(e, atmosphere, "atmosphere");
+    } catch (const Error&) {
+        return OutputEncoding::PhaseFactored;
+    }
+    return OutputEncoding::Residual;
+}
+
 std::uint64_t neural::stream_seed(std::uint64_t seed, std::uint64_t stream) {
     SplitMix64 r{seed ^ (stream * 0xA0761D6478BD642Full)};
     r.next();

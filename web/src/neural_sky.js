@@ -61,6 +61,39 @@ function decodeLog(x, max, logRange) {
   return v > 0 ? f(max * f(Math.exp(f(logRange * f(v - 1))))) : 0;
 }
 
+// Residual outputs: mlp_hd.h's analytic single scattering, in float32
+// operation for operation (kResidualSteps, kResidualRange there).
+const RESIDUAL_STEPS = 4;
+const RESIDUAL_SCALE = f(2 / f(0.5 * ENCODE_SCALE));
+const HALF_PI = f(1.57079632679);
+
+function periapsisAltitude(h, R0, cosChi) {
+  const s2 = f(f(1 - cosChi) * f(1 + cosChi));
+  const s = f(Math.sqrt(s2 > 0 ? s2 : 0));
+  const h0 = f(f(h * s) - f(f(R0 * f(cosChi * cosChi)) / f(1 + s)));
+  return h0 > 0 ? h0 : 0;
+}
+
+function chapmanDepth(h, R0, H, cosChi, rhoH) {
+  const c = f(Math.sqrt(f(f(HALF_PI * f(R0 + h)) / H)));
+  if (cosChi >= 0) return f(f(f(H * rhoH) * c) / f(f(f(c - 1) * cosChi) + 1));
+  const h0 = periapsisAltitude(h, R0, cosChi);
+  const c0 = f(Math.sqrt(f(f(HALF_PI * f(R0 + h0)) / H)));
+  const periapsis = f(f(2 * c0) * f(Math.exp(f(-h0 / H))));
+  return f(H * f(periapsis - f(f(rhoH * c) / f(f(f(c - 1) * -cosChi) + 1))));
+}
+
+function chapmanSegment(R0, H, ha, ca, rhoA, hb, cb, rhoB) {
+  const qa = f(Math.sqrt(f(f(HALF_PI * f(R0 + ha)) / H))), qb = f(Math.sqrt(f(f(HALF_PI * f(R0 + hb)) / H)));
+  const fa = f(f(f(H * rhoA) * qa) / f(f(f(qa - 1) * Math.abs(ca)) + 1));
+  const fb = f(f(f(H * rhoB) * qb) / f(f(f(qb - 1) * Math.abs(cb)) + 1));
+  if (ca >= 0) return f(fa - fb);
+  if (cb < 0) return f(fb - fa);
+  const h0 = periapsisAltitude(ha, R0, ca);
+  const whole = f(f(f(f(2 * H) * f(Math.sqrt(f(f(HALF_PI * f(R0 + h0)) / H)))) * f(Math.exp(f(-h0 / H)))));
+  return f(f(whole - fa) - fb);
+}
+
 export class NeuralSky {
   // `json`: the weights file's text or its parsed object. Throws an Error
   // naming the field for a file that is not a skybake neural sky.
@@ -76,19 +109,39 @@ export class NeuralSky {
     this.outputKind = e.outputs ?? 'radiance';
     this.brightness = e.brightness ?? 'log';
     if (!['seed', 'horizon'].includes(this.inputs)) fail(`encoding.inputs '${this.inputs}' is unknown`);
-    if (!['radiance', 'phase-factored'].includes(this.outputKind)) fail(`encoding.outputs '${this.outputKind}' is unknown`);
+    if (!['radiance', 'phase-factored', 'residual'].includes(this.outputKind))
+      fail(`encoding.outputs '${this.outputKind}' is unknown`);
     if (!['log', 'linear'].includes(this.brightness)) fail(`encoding.brightness '${this.brightness}' is unknown`);
     this.maxN = finiteNumber(e.max_n, 'encoding.max_n');
     this.logRange = finiteNumber(e.log_range, 'encoding.log_range');
     this.terms = [];
-    if (this.outputKind === 'phase-factored') {
+    const factored = this.outputKind !== 'radiance';
+    if (factored) {
       for (const term of e.terms ?? fail('encoding.terms is missing')) {
         const phase = PHASES[term.phase] ?? fail(`phase '${term.phase}' is unknown`);
-        this.terms.push({ phase, g: finiteNumber(term.g ?? 0, 'terms.g'), max: term.max_s.map((m) => finiteNumber(m, 'terms.max_s')) });
+        this.terms.push({ phase, g: finiteNumber(term.g ?? 0, 'terms.g'), max: term.max_s.map((m) => finiteNumber(m, 'terms.max_s')),
+          component: term.component });
       }
     }
-    const outputs = this.outputKind === 'phase-factored' ? 3 * this.terms.length : 4;
+    const outputs = factored ? 3 * this.terms.length : 4;
     const a = d.atmosphere ?? fail('no atmosphere');
+    if (this.outputKind === 'residual') {
+      // The march's atmosphere: its exponential components, and per term its component's scattering.
+      const vec3 = (v, what) => (Array.isArray(v) && v.length === 3 ? v.map((x) => finiteNumber(x, what)) : fail(`${what} must be [r, g, b]`));
+      this.ext = [];
+      for (const c of a.components ?? fail('atmosphere.components is missing')) {
+        if ((c.profile?.type ?? 'exponential') !== 'exponential') continue;
+        const ext = { H: finiteNumber(c.profile?.scale_height_km ?? 8, 'scale_height_km'), beta: vec3(c.extinction_per_km, 'extinction_per_km'), name: c.name };
+        this.ext.push(ext);
+        for (const t of this.terms)
+          if (t.component === c.name) {
+            t.ext = this.ext.length - 1;
+            t.beta = vec3(c.scattering_per_km, 'scattering_per_km');
+          }
+      }
+      if (this.ext.length > 4 || this.terms.some((t) => t.ext === undefined))
+        fail('residual outputs need at most 4 exponential components, every scattering one among them');
+    }
     this.R0 = finiteNumber(a.planet_radius_km, 'atmosphere.planet_radius_km');
     this.Rtop = finiteNumber(a.top_radius_km, 'atmosphere.top_radius_km');
     const first = a.components?.[0];
@@ -139,6 +192,118 @@ export class NeuralSky {
     return [in0, f(cosViewSun), f(cosSunZenith), f(f(f(2 * rho) / H) - 1)];
   }
 
+  // Residual outputs: the analytic single scattering per term and channel
+  // (mlp_hd.h's analytic_terms), without the phase functions.
+  analyticTerms(mu, nu, muS, density) {
+    const R0 = f(this.R0), top = f(f(this.Rtop) - R0), two = f(2 * R0);
+    const base = new Float32Array(3 * this.terms.length);
+    const u = f(f(density - 1) / f(density + 1)), u2 = f(u * u);
+    const ln = density > f(0.97) ? f(f(2 * u) * f(1 + f(u2 * f(f(0.333333343) + f(u2 * f(0.2)))))) : f(Math.log(density));
+    let h = f(-f(this.scaleHeight) * ln);
+    h = h > 0 ? (h < top ? h : top) : 0;
+    const r = f(R0 + h);
+    const rho = f(Math.sqrt(f(h * f(two + h))));
+    const rc = f(r * mu), arc = Math.abs(rc);
+    let d;
+    if (mu < 0 && arc >= rho) {
+      const disc = f(f(arc - rho) * f(arc + rho));
+      d = f(f(rho * rho) / f(arc + f(Math.sqrt(disc > 0 ? disc : 0))));
+    } else {
+      const k = f(f(top - h) * f(f(two + top) + h));
+      const disc = f(f(rc * rc) + k);
+      const s = f(Math.sqrt(disc > 0 ? disc : 0));
+      d = rc > 0 ? f(k / f(rc + s)) : f(-rc + s);
+    }
+    // The planet's shadow on the ray (shadow_span).
+    let lo = 0, hi = d, shadow = true;
+    const c = f(r * muS);
+    if (nu > 0) { const t = f(-c / nu); hi = hi < t ? hi : t; }
+    else if (nu < 0) { const t = f(-c / nu); lo = lo > t ? lo : t; }
+    else shadow = c < 0;
+    const A = f(f(1 - nu) * f(1 + nu)), B = f(f(2 * r) * f(mu - f(muS * nu))), C = f(f(rho - c) * f(rho + c));
+    if (A <= f(1e-12)) {
+      if (B > 0) { const t = f(-C / B); hi = hi < t ? hi : t; }
+      else if (B < 0) { const t = f(-C / B); lo = lo > t ? lo : t; }
+      else shadow = shadow && C < 0;
+    } else {
+      const D = f(f(B * B) - f(f(4 * A) * C));
+      if (D > 0) {
+        const sq = f(Math.sqrt(D));
+        const q = f(-0.5 * f(B + (B < 0 ? -sq : sq)));
+        const ta = f(q / A), tb = q !== 0 ? f(C / q) : -ta;
+        const t0 = ta < tb ? ta : tb, t1 = ta < tb ? tb : ta;
+        lo = lo > t0 ? lo : t0;
+        hi = hi < t1 ? hi : t1;
+      } else shadow = false;
+    }
+    shadow = shadow && lo < hi;
+    const rho2 = f(rho * rho), twoRMu = f(f(2 * r) * mu);
+    const altitude = (t) => {
+      let q = f(rho2 + f(t * f(twoRMu + t)));
+      q = q > 0 ? q : 0;
+      return f(q / f(f(Math.sqrt(f(q + f(R0 * R0)))) + R0));
+    };
+    const ext = this.ext;
+    const prev = ext.map((e) => f(Math.exp(f(-h / f(e.H)))));
+    const tau = [0, 0, 0];
+    let tPrev = 0;
+    for (let part = 0; part < 2; ++part) {
+      const a = part === 0 ? 0 : (shadow ? hi : d);
+      const b = part === 0 ? (shadow ? lo : d) : d;
+      if (!(b > a)) continue;
+      const dt = f(f(b - a) * f(1 / RESIDUAL_STEPS));
+      let tLow = f(-r * mu);
+      tLow = tLow < a ? a : (tLow > b ? b : tLow);
+      const hEnd = [altitude(a), altitude(b), altitude(tLow)];
+      const cEnd = [f(f(f(r * mu) + a) / f(R0 + hEnd[0])), f(f(f(r * mu) + b) / f(R0 + hEnd[1]))];
+      const sumRho = ext.map(() => 0);
+      const partSum = new Float32Array(base.length);
+      let fk = 0.5;
+      for (let k = 0; k < RESIDUAL_STEPS; ++k) {
+        const t = f(a + f(fk * dt));
+        fk = f(fk + 1);
+        const hp = altitude(t);
+        const rp = f(R0 + hp);
+        const cosChi = f(f(f(r * muS) + f(t * nu)) / rp);
+        const sun = [0, 0, 0];
+        const dens = ext.map((e, i) => {
+          const H = f(e.H);
+          const rhoP = f(Math.exp(f(-hp / H)));
+          sumRho[i] = f(sumRho[i] + f(rhoP * dt));
+          const view = f(f(0.5 * f(rhoP + prev[i])) * f(t - tPrev));
+          const depth = chapmanDepth(hp, R0, H, cosChi, rhoP);
+          for (let ch = 0; ch < 3; ++ch) {
+            tau[ch] = f(tau[ch] + f(f(e.beta[ch]) * view));
+            sun[ch] = f(sun[ch] + f(f(e.beta[ch]) * depth));
+          }
+          prev[i] = rhoP;
+          return rhoP;
+        });
+        tPrev = t;
+        for (let ch = 0; ch < 3; ++ch) {
+          const tr = f(f(Math.exp(f(-f(tau[ch] + sun[ch])))) * dt);
+          this.terms.forEach((term, k2) => {
+            partSum[3 * k2 + ch] = f(partSum[3 * k2 + ch] + f(f(f(term.beta[ch]) * dens[term.ext]) * tr));
+          });
+        }
+      }
+      this.terms.forEach((term, k2) => {
+        const H = f(ext[term.ext].H);
+        const exact = chapmanSegment(R0, H, hEnd[0], cEnd[0], f(Math.exp(f(-hEnd[0] / H))), hEnd[1], cEnd[1],
+          f(Math.exp(f(-hEnd[1] / H))));
+        const g = f(f(f(hEnd[0] + hEnd[1]) - f(2 * hEnd[2])) / H);
+        let w = f(f(g - 0.5) * 0.5);
+        w = w > 0 ? (w < 1 ? w : 1) : 0;
+        w = f(f(w * w) * f(3 - f(2 * w)));
+        const s = sumRho[term.ext];
+        const ratio = s > 0 && exact > 0 ? f(exact / s) : 1;
+        const scale = f(1 + f(w * f(ratio - 1)));
+        for (let ch = 0; ch < 3; ++ch) base[3 * k2 + ch] = f(base[3 * k2 + ch] + f(scale * partSum[3 * k2 + ch]));
+      });
+    }
+    return base;
+  }
+
   // The encoded outputs for the four inputs.
   forward(inputs) {
     const enc = new Float32Array(this.outputs);
@@ -170,6 +335,16 @@ export class NeuralSky {
   // density the relative density of the first component at the observer, in (0, 1].
   radiance(cosViewZenith, cosViewSun, cosSunZenith, density) {
     const enc = this.forward(this.encodeInputs(cosViewZenith, cosViewSun, cosSunZenith, density));
+    if (this.outputKind === 'residual') {
+      const base = this.analyticTerms(f(cosViewZenith), f(cosViewSun), f(cosSunZenith), f(density));
+      const c = [0, 0, 0];
+      this.terms.forEach((t, k) => {
+        const p = t.phase(f(t.g), f(cosViewSun));
+        for (let ch = 0; ch < 3; ++ch)
+          c[ch] = f(c[ch] + f(f(p * base[3 * k + ch]) * f(Math.exp(f(RESIDUAL_SCALE * f(enc[3 * k + ch] - 0.5))))));
+      });
+      return c;
+    }
     if (this.outputKind === 'phase-factored') {
       const c = [0, 0, 0];
       this.terms.forEach((t, k) => {

@@ -57,7 +57,8 @@ function libraryRadiance(model, rows) {
 for (const [file, what] of [
   ['neural/v1_paper.json', 'the seed topology, seed inputs, log brightness'],
   ['neural/v1_shared_linear.json', 'a shared network, linear brightness'],
-  ['neural/v3_earth_default.json', 'the default: horizon inputs, phase-factored outputs'],
+  ['neural/v3_earth_default.json', 'horizon inputs, phase-factored outputs'],
+  ['neural/v3_earth_residual.json', 'the default: horizon inputs, residual outputs'],
 ]) {
   test(`${file} (${what}) matches the library`, { skip: !cli || !data ? 'SKYBAKE_CLI and SKYBAKE_TEST_DATA not set' : false }, () => {
     const model = join(data, file);
