@@ -232,22 +232,24 @@ std::string residual_helpers(const std::string& name, const Dialect& d, const st
     return h0 > 0.0 ? h0 : 0.0;
 }
 
+QFLOAT NAME_chapman(FLOAT h, FLOAT R0, FLOAT H, FLOAT cos_chi) {
+    FLOAT k = sqrt((R0 + h) / H), kc = k * cos_chi;
+    return k / (0.661 * kc + 0.339 * sqrt(kc * kc + 5.51));
+}
+
 QFLOAT NAME_depth(FLOAT h, FLOAT R0, FLOAT H, FLOAT cos_chi, FLOAT rho_h) {
-    FLOAT c = sqrt(1.57079633 * (R0 + h) / H);
-    if (cos_chi >= 0.0) return H * rho_h * c / ((c - 1.0) * cos_chi + 1.0);
+    if (cos_chi >= 0.0) return H * rho_h * NAME_chapman(h, R0, H, cos_chi);
     FLOAT h0 = NAME_periapsis(h, R0, cos_chi);
-    FLOAT c0 = sqrt(1.57079633 * (R0 + h0) / H);
-    return H * (2.0 * c0 * exp(-h0 / H) - rho_h * c / ((c - 1.0) * -cos_chi + 1.0));
+    return H * (2.0 * exp(-h0 / H) * NAME_chapman(h0, R0, H, 0.0) - rho_h * NAME_chapman(h, R0, H, -cos_chi));
 }
 
 QFLOAT NAME_segment(FLOAT R0, FLOAT H, FLOAT ha, FLOAT ca, FLOAT rho_a, FLOAT hb, FLOAT cb, FLOAT rho_b) {
-    FLOAT qa = sqrt(1.57079633 * (R0 + ha) / H), qb = sqrt(1.57079633 * (R0 + hb) / H);
-    FLOAT fa = H * rho_a * qa / ((qa - 1.0) * abs(ca) + 1.0);
-    FLOAT fb = H * rho_b * qb / ((qb - 1.0) * abs(cb) + 1.0);
+    FLOAT fa = H * rho_a * NAME_chapman(ha, R0, H, abs(ca));
+    FLOAT fb = H * rho_b * NAME_chapman(hb, R0, H, abs(cb));
     if (ca >= 0.0) return fa - fb;
     if (cb < 0.0) return fb - fa;
     FLOAT h0 = NAME_periapsis(ha, R0, ca);
-    return 2.0 * H * sqrt(1.57079633 * (R0 + h0) / H) * exp(-h0 / H) - fa - fb;
+    return 2.0 * H * exp(-h0 / H) * NAME_chapman(h0, R0, H, 0.0) - fa - fb;
 }
 
 )";

@@ -192,11 +192,9 @@ SKYBAKE_HD_INLINE void encode_inputs(const MlpHD& m, float cos_view_zenith, floa
 // per phase term (analytic_terms), a few-step march in the spirit of O'Neil's
 // GPU Gems 2 sky shader, with three changes that make it follow the sky at
 // every altitude and at twilight:
-//  - the sun's optical depth at each step is a Chapman-function estimate,
-//    ρ(r) H Ch(x, cos χ), x = r/H, with Ch interpolating its zenith (1) and
-//    horizontal (√(πx/2)) limits, Ch ≈ c/((c − 1) cos χ + 1), c = √(πx/2);
-//    below the local horizon the whole grazing ray minus its backward half,
-//    2 ρ(x0) H √(π x0/2H) − ρ(r) H Ch(x, −cos χ), x0 = r sin χ the periapsis;
+//  - the sun's optical depth at each step is ρ H Ch(x, χ) with Chapman's
+//    function in closed form (chapman_function); below the local horizon,
+//    the whole grazing ray through its periapsis less the half behind;
 //  - the march covers only the ray's lit parts: the planet's shadow of a
 //    parallel sun is one interval of the ray (shadow_span), so up to two lit
 //    parts of kResidualSteps midpoint steps each;
@@ -259,15 +257,26 @@ SKYBAKE_HD_INLINE float periapsis_altitude(float h, float R0, float cos_chi) {
     return h0 > 0.0f ? h0 : 0.0f;
 }
 
+// Chapman's function for a planet of radius R0 + h in scale heights H,
+// Ch(x, χ) with x = (R0 + h)/H and cos χ ≥ 0, as sqrt(πx/2) erfcx(y),
+// y = sqrt(x/2) cos χ (the large-x form, errors of order 1/x: x is 800 for
+// air and 5,000 for aerosols on Earth), erfcx by Börjesson and Sundberg's
+// approximation (IEEE Trans. Commun. 27(3), 1979; a = 0.339, b = 5.510, 0.3%
+// at worst). With k = sqrt(x) it folds to k/((1 − a) k cos χ + a sqrt(k² cos²χ + b)).
+SKYBAKE_HD_INLINE float chapman_function(float h, float R0, float H, float cos_chi) {
+    const float k = sqrtf((R0 + h) / H), kc = k * cos_chi;
+    return k / (0.661f * kc + 0.339f * sqrtf(kc * kc + 5.51f));
+}
+
 // ∫ ρ ds (km) from altitude h towards cos χ to infinity, ρ = exp(−h/H) given
-// as rho_h (the Chapman estimate above).
+// as rho_h: ρ H Ch above the horizon; below it the whole grazing ray through
+// the periapsis h0 less the half behind, 2 ρ(h0) H Ch(x0, 90°) − ρ H Ch(x, π − χ).
 SKYBAKE_HD_INLINE float chapman_depth(float h, float R0, float H, float cos_chi, float rho_h) {
-    const float c = sqrtf(1.57079632679f * (R0 + h) / H);
     if (cos_chi >= 0.0f)
-        return H * rho_h * c / ((c - 1.0f) * cos_chi + 1.0f);
+        return H * rho_h * chapman_function(h, R0, H, cos_chi);
     const float h0 = periapsis_altitude(h, R0, cos_chi);
-    const float c0 = sqrtf(1.57079632679f * (R0 + h0) / H);
-    return H * (2.0f * c0 * expf(-h0 / H) - rho_h * c / ((c - 1.0f) * -cos_chi + 1.0f));
+    return H * (2.0f * expf(-h0 / H) * chapman_function(h0, R0, H, 0.0f) -
+                rho_h * chapman_function(h, R0, H, -cos_chi));
 }
 
 // ∫ ρ dt over a part [a, b] of a view ray, for an exponential component of
@@ -276,17 +285,16 @@ SKYBAKE_HD_INLINE float chapman_depth(float h, float R0, float H, float cos_chi,
 // passes it) counted once. The view's cosine only grows along the ray.
 SKYBAKE_HD_INLINE float chapman_segment(float R0, float H, float ha, float ca, float rho_a, float hb, float cb,
                                         float rho_b) {
-    const float qa = sqrtf(1.57079632679f * (R0 + ha) / H), qb = sqrtf(1.57079632679f * (R0 + hb) / H);
-    // Ch(x, |cos|) ρ H at each end: forward depth above the horizon, backward below.
-    const float fa = H * rho_a * qa / ((qa - 1.0f) * fabsf(ca) + 1.0f);
-    const float fb = H * rho_b * qb / ((qb - 1.0f) * fabsf(cb) + 1.0f);
+    // ρ H Ch(x, |cos|) at each end: forward depth above the horizon, backward below.
+    const float fa = H * rho_a * chapman_function(ha, R0, H, fabsf(ca));
+    const float fb = H * rho_b * chapman_function(hb, R0, H, fabsf(cb));
     if (ca >= 0.0f)
         return fa - fb; // both ends above their horizons: forward(a) − forward(b)
     if (cb < 0.0f)
         return fb - fa; // both below: backward(b) − backward(a)
-    // Through the periapsis: 2 ρ(h0) H Ch(x0, 0) − backward(a) − forward(b).
+    // Through the periapsis: 2 ρ(h0) H Ch(x0, 90°) − backward(a) − forward(b).
     const float h0 = periapsis_altitude(ha, R0, ca);
-    return 2.0f * H * sqrtf(1.57079632679f * (R0 + h0) / H) * expf(-h0 / H) - fa - fb;
+    return 2.0f * H * expf(-h0 / H) * chapman_function(h0, R0, H, 0.0f) - fa - fb;
 }
 
 // The analytic single scattering A per phase term and channel (1/sr per unit

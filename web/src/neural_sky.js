@@ -65,7 +65,6 @@ function decodeLog(x, max, logRange) {
 // operation for operation (kResidualSteps, kResidualRange there).
 const RESIDUAL_STEPS = 4;
 const RESIDUAL_SCALE = f(2 / f(0.5 * ENCODE_SCALE));
-const HALF_PI = f(1.57079632679);
 
 function periapsisAltitude(h, R0, cosChi) {
   const s2 = f(f(1 - cosChi) * f(1 + cosChi));
@@ -74,23 +73,25 @@ function periapsisAltitude(h, R0, cosChi) {
   return h0 > 0 ? h0 : 0;
 }
 
+function chapman(h, R0, H, cosChi) {
+  const k = f(Math.sqrt(f(f(R0 + h) / H))), kc = f(k * cosChi);
+  return f(k / f(f(f(0.661) * kc) + f(f(0.339) * f(Math.sqrt(f(f(kc * kc) + f(5.51)))))));
+}
+
 function chapmanDepth(h, R0, H, cosChi, rhoH) {
-  const c = f(Math.sqrt(f(f(HALF_PI * f(R0 + h)) / H)));
-  if (cosChi >= 0) return f(f(f(H * rhoH) * c) / f(f(f(c - 1) * cosChi) + 1));
+  if (cosChi >= 0) return f(f(H * rhoH) * chapman(h, R0, H, cosChi));
   const h0 = periapsisAltitude(h, R0, cosChi);
-  const c0 = f(Math.sqrt(f(f(HALF_PI * f(R0 + h0)) / H)));
-  const periapsis = f(f(2 * c0) * f(Math.exp(f(-h0 / H))));
-  return f(H * f(periapsis - f(f(rhoH * c) / f(f(f(c - 1) * -cosChi) + 1))));
+  const whole = f(f(2 * f(Math.exp(f(-h0 / H)))) * chapman(h0, R0, H, 0));
+  return f(H * f(whole - f(rhoH * chapman(h, R0, H, -cosChi))));
 }
 
 function chapmanSegment(R0, H, ha, ca, rhoA, hb, cb, rhoB) {
-  const qa = f(Math.sqrt(f(f(HALF_PI * f(R0 + ha)) / H))), qb = f(Math.sqrt(f(f(HALF_PI * f(R0 + hb)) / H)));
-  const fa = f(f(f(H * rhoA) * qa) / f(f(f(qa - 1) * Math.abs(ca)) + 1));
-  const fb = f(f(f(H * rhoB) * qb) / f(f(f(qb - 1) * Math.abs(cb)) + 1));
+  const fa = f(f(H * rhoA) * chapman(ha, R0, H, Math.abs(ca)));
+  const fb = f(f(H * rhoB) * chapman(hb, R0, H, Math.abs(cb)));
   if (ca >= 0) return f(fa - fb);
   if (cb < 0) return f(fb - fa);
   const h0 = periapsisAltitude(ha, R0, ca);
-  const whole = f(f(f(f(2 * H) * f(Math.sqrt(f(f(HALF_PI * f(R0 + h0)) / H)))) * f(Math.exp(f(-h0 / H)))));
+  const whole = f(f(f(2 * H) * f(Math.exp(f(-h0 / H)))) * chapman(h0, R0, H, 0));
   return f(f(whole - fa) - fb);
 }
 
