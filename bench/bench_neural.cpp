@@ -110,6 +110,39 @@ void BM_NeuralScalarOneCore(benchmark::State& state) {
     state.counters["vs_tables"] = rate / base;
 }
 
+// The default network's size with phase-factored (0) or residual (1) outputs,
+// horizon inputs: what the analytic march of the residual costs per sample in
+// the scalar pass (the exported shaders' arithmetic), against the same
+// network without it, measured in the same run.
+void BM_NeuralScalarOutputs(benchmark::State& state) {
+    const double base = tables_rate();
+    NeuralSky net = random_net("shared:16x12");
+    net.encoding.inputs = InputEncoding::Horizon;
+    net.encoding.outputs = state.range(0) ? OutputEncoding::Residual : OutputEncoding::PhaseFactored;
+    for (int k : neural::phase_term_components(net.atmosphere)) {
+        const AtmosphereComponent& c = net.atmosphere.components[std::size_t(k)];
+        net.encoding.terms.push_back({c.name, c.phase, c.phase_g, glm::dvec3(1.0)});
+    }
+    net.topology.outputs = net.encoding.output_count();
+    net.weights.resize(std::size_t(net.topology.weight_count()), 0.01f);
+    state.SetLabel(fmt::format("shared:16x12, horizon/{} ({} weights)", output_encoding_name(net.encoding.outputs),
+                               net.topology.weight_count()));
+    const neural::MlpHD hd = neural::make_mlp_hd(net);
+    std::vector<glm::vec3> out(samples().size());
+    const auto t0 = std::chrono::steady_clock::now();
+    for (auto _ : state) {
+        for (std::size_t i = 0; i < samples().size(); ++i) {
+            const SkySample& x = samples()[i];
+            out[i] = neural::neural_sky(hd, x.cos_view_zenith, x.cos_view_sun, x.cos_sun_zenith, x.density);
+        }
+        benchmark::DoNotOptimize(out.data());
+    }
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double rate = double(samples().size()) * double(state.iterations()) / s;
+    state.counters["samples_per_s"] = rate;
+    state.counters["vs_tables"] = rate / base;
+}
+
 void BM_TrainPaper800k(benchmark::State& state) {
     NeuralTrainOptions o;
     o.progress = false;
@@ -161,6 +194,7 @@ void compare_sample_counts(const std::filesystem::path& dir) {
 BENCHMARK(BM_SkyTables)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_NeuralBatch)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_NeuralScalarOneCore)->Arg(0)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_NeuralScalarOutputs)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_TrainPaper800k)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 
 int main(int argc, char** argv) {

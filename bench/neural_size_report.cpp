@@ -50,6 +50,8 @@ const Encoding kEncodings[] = {
     {"horizon/radiance", InputEncoding::Horizon, OutputEncoding::Radiance, {0.9f, 0.6f, 0.1f}},
     {"seed/phase-factored", InputEncoding::Seed, OutputEncoding::PhaseFactored, {0.2f, 0.5f, 0.9f}},
     {"horizon/phase-factored", InputEncoding::Horizon, OutputEncoding::PhaseFactored, {0.9f, 0.2f, 0.2f}},
+    // No look-up table holds residual outputs (they correct a march per sample).
+    {"horizon/residual", InputEncoding::Horizon, OutputEncoding::Residual, {0.2f, 0.8f, 0.3f}},
 };
 constexpr const char* kHeader =
     "encoding,kind,topology,floats,mean_relative,p50_relative,mean_psnr_db,min_psnr_db,seconds";
@@ -85,6 +87,9 @@ void draw_charts(const std::filesystem::path& out) {
             psnr[series].y.push_back(std::stod(f[6]));
         }
     }
+    // Series with no rows (no table holds residual outputs) stay out of the legend.
+    for (std::vector<ChartSeries>* v : {&err, &psnr})
+        std::erase_if(*v, [](const ChartSeries& s) { return s.x.empty(); });
     save_image(out / "neural_size_error.png",
                draw_line_chart(err, "earth: mean relative error (networks bright, tables dark)",
                                "log10 weights (floats)", "mean relative error, %", 900, 560),
@@ -113,14 +118,18 @@ void table_row(std::ofstream& csv, const Encoding& e, const SkyModel& model, con
 
 int main(int argc, char** argv) {
     if (argc < 2) {
-        std::fprintf(stderr, "usage: neural_size_report OUT_DIR [--quick] [--tables-only | --charts-only]\n");
+        std::fprintf(stderr, "usage: neural_size_report OUT_DIR [--quick] [--tables-only | --charts-only | "
+                             "--encoding NAME]\n");
         return 2;
     }
     const std::filesystem::path out = argv[1];
     bool quick = false, tables_only = false, charts_only = false;
+    std::string only; // --encoding: that encoding's networks, appended to the CSV
     for (int i = 2; i < argc; ++i) {
         if (std::strcmp(argv[i], "--quick") == 0)
             quick = true;
+        else if (std::strcmp(argv[i], "--encoding") == 0 && i + 1 < argc)
+            only = argv[++i];
         else if (std::strcmp(argv[i], "--tables-only") == 0)
             tables_only = true;
         else if (std::strcmp(argv[i], "--charts-only") == 0)
@@ -151,7 +160,7 @@ int main(int argc, char** argv) {
         atm.table_rule = TableRule::Refined;
         const SkyModel model(atm, so);
         const std::filesystem::path csv_path = out / "neural_size.csv";
-        const bool fresh = !tables_only || !std::filesystem::exists(csv_path);
+        const bool fresh = (!tables_only && only.empty()) || !std::filesystem::exists(csv_path);
         std::ofstream csv(csv_path, fresh ? std::ios::trunc : std::ios::app);
         if (fresh)
             csv << kHeader << "\n";
@@ -171,6 +180,8 @@ int main(int argc, char** argv) {
             if (tables_only)
                 break;
             for (const Encoding& e : kEncodings) {
+                if (!only.empty() && only != e.name)
+                    continue;
                 NeuralTrainOptions o = options(e);
                 o.topology = parse_topology(s.topology);
                 o.adam_epochs = quick ? 4 : s.epochs;
@@ -181,17 +192,25 @@ int main(int argc, char** argv) {
                 csv << fmt::format("{},network,{},{},{:.6g},{:.6g},{:.4f},{:.4f},{:.1f}\n", e.name,
                                    net.topology.name(), net.weights.size(), r.all.mean, r.all.p50,
                                    r.mean_view_psnr_db, r.min_view_psnr_db, net.training.seconds);
-                std::printf("%-24s %-16s %6zu weights: mean %7.3f%%, views %5.2f / %5.2f dB, %5.1f s\n", e.name,
-                            net.topology.name().c_str(), net.weights.size(), 100 * r.all.mean, r.mean_view_psnr_db,
-                            r.min_view_psnr_db, net.training.seconds);
-                table_row(csv, e, model, o, net.weights.size(), eo);
+                std::printf("%-24s %-16s %6zu weights: mean %7.3f%% (twilight %.2f%%, flight %.2f%%, flight twilight "
+                            "%.2f%%), views %5.2f / %5.2f dB, %5.1f s\n",
+                            e.name, net.topology.name().c_str(), net.weights.size(), 100 * r.all.mean,
+                            100 * r.twilight.mean, 100 * r.flight_all.mean, 100 * r.flight_twilight.mean,
+                            r.mean_view_psnr_db, r.min_view_psnr_db, net.training.seconds);
+                std::fflush(stdout);
+                if (e.outputs != OutputEncoding::Residual)
+                    table_row(csv, e, model, o, net.weights.size(), eo);
             }
             draw_charts(out);
         }
         // Tables beyond the networks' sizes, fitted to enough samples that
         // every node is seen (about 24 per node).
         for (std::size_t floats : large_tables) {
+            if (!only.empty())
+                break;
             for (const Encoding& e : kEncodings) {
+                if (e.outputs == OutputEncoding::Residual)
+                    continue;
                 NeuralTrainOptions o = options(e);
                 const std::size_t outputs = std::size_t(neural::make_training_encoding(model, o).output_count());
                 o.samples = std::max(o.samples, 24 * (quick ? floats / 10 : floats) / outputs);

@@ -62,9 +62,9 @@ TEST(NeuralCli, TrainWritesWeightsCurveAndChart) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["topology"], "shared:6x6");
-    // The default encodings: horizon inputs, phase-factored outputs (paper: Rayleigh and Mie, 3 channels each).
+    // The default encodings: horizon inputs, residual outputs (paper: Rayleigh and Mie, 3 channels each).
     EXPECT_EQ(j["inputs"], "horizon");
-    EXPECT_EQ(j["outputs"], "phase-factored");
+    EXPECT_EQ(j["outputs"], "residual");
     EXPECT_EQ(j["weights"], 5 * 6 + 7 * 6 + 7 * 6);
     EXPECT_EQ(j["samples"], 2000);
     EXPECT_GT(j["max_n"].get<double>(), 0.0);

@@ -108,14 +108,16 @@ enum class InputEncoding : int { Seed = 0, Horizon = 1 };
 // a few-step march over the view ray's lit parts with Chapman-function sun
 // depths (src/neural/mlp_hd.h, analytic_terms): per term and channel the log
 // of S_k over the march's A_k. The march carries the decades (altitude, the
-// planet's shadow); the network the few tens of percent it misses. Single
-// scattering, and the terms' components must have exponential profiles.
+// planet's shadow); the network the few tens of percent it misses. With
+// multiple scattering, three more outputs carry the light scattered more than
+// once (NeuralEncoding::multiple). The terms' components must have
+// exponential profiles.
 enum class OutputEncoding : int { Radiance = 0, PhaseFactored = 1, Residual = 2 };
 // Phase-factored and residual outputs: one term per scattering component.
 inline bool has_phase_terms(OutputEncoding e) { return e != OutputEncoding::Radiance; }
 // The outputs `sky train` and train_sky() choose when none are asked for:
-// residual for single scattering (phase-factored where a scattering
-// component is not exponential), radiance with multiple scattering.
+// residual where every scattering component is exponential, else
+// phase-factored for single scattering and radiance with multiple.
 OutputEncoding default_output_encoding(const Atmosphere& atmosphere);
 const char* input_encoding_name(InputEncoding encoding);
 const char* output_encoding_name(OutputEncoding encoding);
@@ -139,7 +141,16 @@ struct NeuralEncoding {
     std::vector<PhaseTerm> terms; // PhaseFactored and Residual: one per scattering component, 1 to 4
 
     // Encoded outputs: 4 (radiance) or 3 per term.
-    int output_count() const { return outputs == OutputEncoding::Radiance ? 4 : 3 * int(terms.size()); }
+    // Residual outputs of a sky with multiple scattering: three more outputs,
+    // the light scattered more than once (the total less the single
+    // scattering), log-encoded per channel like a phase-factored term, below
+    // multiple_max (the largest over the max{N} samples) over 12 decades
+    // (kMultipleLogRange in src/neural/mlp_hd.h).
+    bool multiple = false;
+    glm::dvec3 multiple_max{1.0};
+    int output_count() const {
+        return outputs == OutputEncoding::Radiance ? 4 : 3 * int(terms.size()) + (multiple ? 3 : 0);
+    }
 };
 
 // Encoded target (4 values in [0, 1]) of a radiance, and the radiance of 4

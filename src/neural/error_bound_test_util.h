@@ -41,12 +41,18 @@ inline NeuralSky random_network(const char* topology, unsigned seed) {
 
 // The same network with other encodings: phase terms from its atmosphere's
 // scattering components (maxima of a realistic size), and new pseudo-random
-// weights when the output count changes the weight count.
-inline NeuralSky with_encoding(NeuralSky net, InputEncoding inputs, OutputEncoding outputs, unsigned seed) {
+// weights when the output count changes the weight count. `multiple`:
+// residual outputs of the atmosphere with multiple scattering, its term too.
+inline NeuralSky with_encoding(NeuralSky net, InputEncoding inputs, OutputEncoding outputs, unsigned seed,
+                               bool multiple = false) {
     net.encoding.inputs = inputs;
     net.encoding.outputs = outputs;
     net.encoding.brightness = BrightnessEncoding::Log;
     net.encoding.terms.clear();
+    net.encoding.multiple = multiple;
+    net.encoding.multiple_max = glm::dvec3(0.01, 0.02, 0.04);
+    if (multiple)
+        net.atmosphere.scattering = Scattering::Multiple;
     if (has_phase_terms(outputs))
         for (int k : neural::phase_term_components(net.atmosphere)) {
             const AtmosphereComponent& c = net.atmosphere.components[std::size_t(k)];

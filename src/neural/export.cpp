@@ -84,7 +84,8 @@ namespace {
 // log range, then with horizon inputs R0, Rtop − R0, √(Rtop² − R0²) and the
 // scale height; then with residual outputs R0, Rtop − R0, the scale height,
 // per exponential component its scale height and extinction (r, g, b), per
-// term its scattering (r, g, b), and per term g; else per phase term g and
+// term its scattering (r, g, b), per term g, and with multiple scattering the
+// largest multiply scattered light (r, g, b); else per phase term g and
 // max S (r, g, b). This is the order the exporter reads them in.
 std::vector<float> encoding_constants(const NeuralSky& net) {
     const MlpHD m = make_mlp_hd(net);
@@ -101,6 +102,8 @@ std::vector<float> encoding_constants(const NeuralSky& net) {
             c.insert(c.end(), {m.term_beta[k][0], m.term_beta[k][1], m.term_beta[k][2]});
         for (int k = 0; k < m.terms; ++k)
             c.push_back(m.term_g[k]);
+        if (m.multiple)
+            c.insert(c.end(), {m.multiple_max[0], m.multiple_max[1], m.multiple_max[2]});
         return c;
     }
     for (int k = 0; k < m.terms; ++k)
@@ -448,6 +451,18 @@ void emit_residual_decoding(std::ostringstream& o, const NeuralSky& net, const M
                              outputs[std::size_t(3 * k + c)], half);
         o << "    }\n";
     }
+    if (m.multiple) {
+        const std::string inv = lit(1.0f / kEncodeScale, d), off = lit(kEncodeOffset, d), one = lit(1.0f, d);
+        o << "    { // the light scattered more than once, log-encoded per channel\n";
+        for (int c = 0; c < 3; ++c) {
+            const std::string mx = constant(m.multiple_max[c]);
+            o << fmt::format("        float v{} = ({} - {}) * {};\n", c, outputs[std::size_t(3 * m.terms + c)], off,
+                             inv);
+            o << fmt::format("        {} += v{} > {} ? {} * {}({} * (v{} - {})) : {};\n", acc[c], c, zero, mx, d.exp,
+                             lit(kMultipleLogRange, d), c, one, zero);
+        }
+        o << "    }\n";
+    }
     if (d.shader)
         o << fmt::format("    return {}(cr, cg, cb);\n", d.vec3);
     else
@@ -494,7 +509,8 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const S
     o << "// Inputs: cos_view_zenith = V.U, cos_view_sun = V.L, cos_sun_zenith = U.L (V: view direction,\n"
          "// U: local vertical at the observer, L: direction to the sun, all unit vectors) and density =\n"
          "// relative density of the first atmosphere component at the observer, in (0, 1].\n";
-    o << "// Output: single-scattered radiance per unit sun irradiance (1/sr), linear RGB; multiply by the\n";
+    o << fmt::format("// Output: {} radiance per unit sun irradiance (1/sr), linear RGB; multiply by the\n",
+                     net.atmosphere.scattering == Scattering::Single ? "single-scattered" : "total (single + multiple)");
     if (ubo)
         o << fmt::format("// sun's irradiance. Valid in vertex and fragment shaders; the weights come from the uniform\n"
                          "// block {} (std140, {} vec4s: the weights, then the encoding's constants).\n",
@@ -557,6 +573,9 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const S
         for (const PhaseTerm& t : net.encoding.terms)
             for (const char* c : {"r", "g", "b"})
                 out_names.push_back(fmt::format("S {} {}", t.component, c));
+        if (m.multiple)
+            for (const char* c : {"r", "g", "b"})
+                out_names.push_back(fmt::format("multiple {}", c));
     }
     std::vector<std::string> outputs;
     for (int s = 0; s < lay.subnets; ++s) {

@@ -96,6 +96,9 @@ void set_encoding_hd(const NeuralEncoding& e, const Atmosphere& atmosphere, MlpH
     }
     if (e.outputs != OutputEncoding::Residual)
         return;
+    m.multiple = e.multiple ? 1 : 0;
+    for (int c = 0; c < 3; ++c)
+        m.multiple_max[c] = float(e.multiple_max[c]);
     // The analytic march's atmosphere (check_residual_atmosphere has checked it fits).
     m.ext_count = 0;
     for (const AtmosphereComponent& c : atmosphere.components)
@@ -114,10 +117,11 @@ void set_encoding_hd(const NeuralEncoding& e, const Atmosphere& atmosphere, MlpH
 }
 
 void check_residual_atmosphere(const NeuralEncoding& e, const Atmosphere& atmosphere, const std::string& where) {
-    if (atmosphere.scattering != Scattering::Single)
-        throw Error("residual outputs correct an analytic single scattering; train radiance outputs for an "
-                    "atmosphere with multiple scattering",
-                    where + ": encoding.outputs");
+    if ((atmosphere.scattering != Scattering::Single) != e.multiple)
+        throw Error(e.multiple ? "a multiple-scattering term needs an atmosphere with multiple scattering"
+                               : "residual outputs of an atmosphere with multiple scattering need its term "
+                                 "(encoding.multiple_max)",
+                    where + ": encoding.multiple_max");
     int exponential = 0;
     for (const AtmosphereComponent& c : atmosphere.components)
         exponential += c.profile == DensityProfile::Exponential ? 1 : 0;

@@ -23,7 +23,7 @@ namespace skybake::neural {
 constexpr int kInputs = 4;
 constexpr int kOutputs = 4;     // the seed's outputs: R, G, B, M
 constexpr int kMaxTerms = 4;    // phase-factored: one RGB term per scattering component
-constexpr int kMaxOutputs = 3 * kMaxTerms;
+constexpr int kMaxOutputs = 3 * kMaxTerms + 3; // and residual outputs' multiple-scattering term
 constexpr int kMaxHidden = 7;              // hidden layers
 constexpr int kMaxLayers = kMaxHidden + 1; // weight layers
 constexpr int kMaxWidth = 128;
@@ -40,6 +40,9 @@ enum : int { kOutputsRadiance = 0, kOutputsPhaseFactored = 1, kOutputsResidual =
 // and the half range of the log ratio the network encodes (nats).
 constexpr int kResidualSteps = 4;
 constexpr float kResidualRange = 2.0f;
+// Their multiple-scattering term's log range: 12 decades (nats), down to the
+// sky of a sun 20° below the horizon (which the sky's own 6 would cut).
+constexpr float kMultipleLogRange = 27.6310211f;
 
 struct MlpHD {
     const float* weights = nullptr; // subnets * subnet_params floats
@@ -69,6 +72,9 @@ struct MlpHD {
     float ext_beta[kMaxTerms][3] = {};
     int term_ext[kMaxTerms] = {};
     float term_beta[kMaxTerms][3] = {};
+    // and with multiple scattering, the log-encoded term after the others.
+    int multiple = 0;
+    float multiple_max[3] = {};
 };
 
 SKYBAKE_HD_INLINE float seed_activation(float x) { return 1.0f / (1.0f + exp2f(2.0f * x)); }
@@ -424,6 +430,12 @@ SKYBAKE_HD_INLINE glm::vec3 decode_sky(const MlpHD& m, const float* enc, float c
             c.x += p * base[3 * k + 0] * expf(scale * (enc[3 * k + 0] - 0.5f));
             c.y += p * base[3 * k + 1] * expf(scale * (enc[3 * k + 1] - 0.5f));
             c.z += p * base[3 * k + 2] * expf(scale * (enc[3 * k + 2] - 0.5f));
+        }
+        if (m.multiple) { // the light scattered more than once, log-encoded
+            const float* x = enc + 3 * m.terms;
+            c.x += decode_log(x[0], m.multiple_max[0], kMultipleLogRange);
+            c.y += decode_log(x[1], m.multiple_max[1], kMultipleLogRange);
+            c.z += decode_log(x[2], m.multiple_max[2], kMultipleLogRange);
         }
         return c;
     }

@@ -120,6 +120,14 @@ void NeuralSky::validate(const std::string& where) const {
     } else if (!encoding.terms.empty()) {
         throw Error("radiance outputs have no phase terms", where + ": encoding.terms");
     }
+    if (encoding.multiple) {
+        if (encoding.outputs != OutputEncoding::Residual)
+            throw Error("only residual outputs have a multiple-scattering term", where + ": encoding.multiple_max");
+        for (int c = 0; c < 3; ++c)
+            if (!(std::isfinite(encoding.multiple_max[c]) && encoding.multiple_max[c] >= 1e-30 &&
+                  encoding.multiple_max[c] <= 1e30))
+                throw Error("encoding.multiple_max must be numbers in [1e-30, 1e30]", where);
+    }
     if (encoding.outputs == OutputEncoding::Residual)
         neural::check_residual_atmosphere(encoding, atmosphere, where);
     if (topology.outputs != encoding.output_count())
@@ -163,6 +171,8 @@ std::string neural_sky_to_json(const NeuralSky& net) {
                              {"max_s", {t.max_s.x, t.max_s.y, t.max_s.z}}});
         j["encoding"]["terms"] = std::move(terms);
     }
+    if (e.multiple)
+        j["encoding"]["multiple_max"] = {e.multiple_max.x, e.multiple_max.y, e.multiple_max.z};
     json subnets = json::array();
     const std::size_t per = std::size_t(net.topology.subnet_weight_count());
     for (int s = 0; s < net.topology.subnet_count(); ++s) {
@@ -287,6 +297,14 @@ NeuralSky neural_sky_from_json(std::string_view text, const std::string& where) 
                     p.max_s = glm::dvec3(mx[0].get<double>(), mx[1].get<double>(), mx[2].get<double>());
                     net.encoding.terms.push_back(p);
                 }
+            }
+            if (enc.contains("multiple_max")) {
+                const json& mm = enc["multiple_max"];
+                if (!mm.is_array() || mm.size() != 3 || !mm[0].is_number() || !mm[1].is_number() ||
+                    !mm[2].is_number())
+                    throw Error("encoding.multiple_max must be [r, g, b]", where);
+                net.encoding.multiple = true;
+                net.encoding.multiple_max = glm::dvec3(mm[0].get<double>(), mm[1].get<double>(), mm[2].get<double>());
             }
             net.topology.outputs = integer(top, "outputs", where + ": topology", 1, neural::kMaxOutputs);
             if (net.topology.outputs != net.encoding.output_count())

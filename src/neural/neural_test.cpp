@@ -366,16 +366,16 @@ TEST(NeuralTraining, LossDecreasesAndIsDeterministic) {
         EXPECT_LE(curve[i].train_rms, curve[i - 1].train_rms * (1.0 + 1e-6));
     EXPECT_GT(a.encoding.max_n, 0.0);
     EXPECT_EQ(a.training.samples, 4000u);
-    // The default encodings (horizon inputs, phase-factored outputs) too.
+    // The default encodings (horizon inputs, residual outputs) too.
     o.inputs = InputEncoding::Horizon;
-    o.outputs = OutputEncoding::PhaseFactored;
+    o.outputs = OutputEncoding::Residual;
     o.topology = parse_topology("shared:8x6");
     set_thread_count(2);
     const NeuralSky c = train_neural_sky(model, o);
     set_thread_count(1);
     const NeuralSky d = train_neural_sky(model, o);
     set_thread_count(threads);
-    EXPECT_EQ(c.encoding.outputs, OutputEncoding::PhaseFactored);
+    EXPECT_EQ(c.encoding.outputs, OutputEncoding::Residual);
     EXPECT_EQ(c.weights, d.weights);
     EXPECT_EQ(c.encoding.terms.size(), d.encoding.terms.size());
     for (std::size_t k = 0; k < c.encoding.terms.size() && k < d.encoding.terms.size(); ++k)
@@ -884,7 +884,7 @@ TEST(ImagePsnr, IsTheClosedFormAndANaNPixelIsTheLargestError) {
 TEST(NeuralSky, SharedTestVectorsAreTheScalarPass) {
     const std::filesystem::path file = std::filesystem::path(SKYBAKE_SOURCE_DIR) / "tests/data/neural/test_vectors.json";
     const char* networks[] = {"v1_paper.json", "v1_shared_linear.json", "v3_earth_default.json",
-                              "v3_earth_residual.json"};
+                              "v3_earth_residual.json", "v3_earth_multiple.json"};
     if (const char* w = std::getenv("SKYBAKE_WRITE_TEST_VECTORS"); w && std::string(w) == "1") {
         nlohmann::ordered_json out = {{"format", "skybake-neural-test-vectors"}, {"version", 1},
                                       {"columns", {"cos_view_zenith", "cos_view_sun", "cos_sun_zenith", "density", "r", "g", "b"}}};

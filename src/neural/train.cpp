@@ -78,6 +78,22 @@ TrainingData neural::make_training_data(const SkyModel& model, const NeuralEncod
         d.base = analytic_matrix(hd, s);
         encode_residual_targets(split, model.atmosphere().components.size(),
                                 phase_term_components(model.atmosphere()), d.base, d.t, d.mask);
+        if (enc.multiple) {
+            // Three more rows: the total less the single scattering, log-encoded.
+            std::vector<glm::vec3> total(n);
+            sky_targets(model, s, total, device);
+            const Eigen::Index rows = d.t.rows();
+            d.t.conservativeResize(rows + 3, Eigen::NoChange);
+            d.mask.conservativeResize(rows + 3, Eigen::NoChange);
+            for (std::size_t i = 0; i < n; ++i) {
+                const glm::vec3 more = glm::max(total[i] - d.radiance[i], glm::vec3(0.0f));
+                for (int c = 0; c < 3; ++c) {
+                    d.t(rows + c, Eigen::Index(i)) = encode_log(double(more[c]), enc.multiple_max[c], double(kMultipleLogRange));
+                    d.mask(rows + c, Eigen::Index(i)) = 1.0f;
+                }
+            }
+            d.radiance = std::move(total);
+        }
     } else if (enc.outputs == OutputEncoding::PhaseFactored) {
         std::vector<glm::vec3> split;
         split_targets(model, s, split, d.radiance);
@@ -248,16 +264,15 @@ NormalPart normal_equations(const Layout& lay, const std::vector<float>& w, int 
 } // namespace
 
 OutputEncoding default_output_encoding(const Atmosphere& atmosphere) {
-    if (atmosphere.scattering != Scattering::Single)
-        return OutputEncoding::Radiance;
     NeuralEncoding e;
     e.outputs = OutputEncoding::Residual;
+    e.multiple = atmosphere.scattering != Scattering::Single;
     for (int k : phase_term_components(atmosphere))
         e.terms.push_back({atmosphere.components[std::size_t(k)].name});
     try {
         check_residual_atmosphere(e, atmosphere, "atmosphere");
     } catch (const Error&) {
-        return OutputEncoding::PhaseFactored;
+        return e.multiple ? OutputEncoding::Radiance : OutputEncoding::PhaseFactored;
     }
     return OutputEncoding::Residual;
 }
@@ -274,9 +289,9 @@ NeuralEncoding neural::make_training_encoding(const SkyModel& model, const Neura
         throw Error("the log range must be in (0, 200) nats", "log_range");
     const std::vector<int> term_components = phase_term_components(model.atmosphere());
     if (has_phase_terms(o.outputs)) {
-        if (model.atmosphere().scattering != Scattering::Single)
-            throw Error("phase-factored outputs are exact for single scattering only; use outputs radiance for an "
-                        "atmosphere with multiple scattering",
+        if (o.outputs == OutputEncoding::PhaseFactored && model.atmosphere().scattering != Scattering::Single)
+            throw Error("phase-factored outputs are exact for single scattering only; use outputs residual or "
+                        "radiance for an atmosphere with multiple scattering",
                         "outputs");
         if (o.brightness != BrightnessEncoding::Log)
             throw Error("phase-factored outputs are log-encoded; the linear brightness is for radiance outputs",
@@ -305,6 +320,16 @@ NeuralEncoding neural::make_training_encoding(const SkyModel& model, const Neura
                     if (!(t.max_s[ch] > 0.0))
                         t.max_s[ch] = 1e-30; // a channel this component never scatters: decoded as (almost) 0
                 encoding.terms.push_back(t);
+            }
+            if (o.outputs == OutputEncoding::Residual && model.atmosphere().scattering != Scattering::Single) {
+                // The multiple-scattering term: the total less the single scattering.
+                std::vector<glm::vec3> total(s.size());
+                sky_targets(model, s, total, o.device);
+                encoding.multiple = true;
+                encoding.multiple_max = glm::dvec3(1e-30);
+                for (std::size_t i = 0; i < s.size(); ++i)
+                    encoding.multiple_max = glm::max(encoding.multiple_max, glm::dvec3(total[i] - r[i]));
+                r = std::move(total);
             }
         } else {
             r.resize(s.size());

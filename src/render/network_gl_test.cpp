@@ -159,8 +159,9 @@ TEST(GlNetwork, WiderSharedTopologyMatchesToo) {
 
 // A random shared:12x8 network with the given encodings and moderate
 // weights: the tests compare arithmetic, not saturated sigmoids.
-NeuralSky encoded_network(InputEncoding inputs, OutputEncoding outputs) {
-    NeuralSky net = neural_test::with_encoding(neural_test::random_network("shared:12x8", 7), inputs, outputs, 8);
+NeuralSky encoded_network(InputEncoding inputs, OutputEncoding outputs, bool multiple = false) {
+    NeuralSky net =
+        neural_test::with_encoding(neural_test::random_network("shared:12x8", 7), inputs, outputs, 8, multiple);
     for (float& w : net.weights)
         w *= 0.5f;
     return net;
@@ -204,6 +205,19 @@ TEST(GlNetwork, EveryEncodingMatchesTheCppForwardPass) {
             std::printf("GLSL network (%s inputs, %s outputs) vs mlp_hd.h: max relative error %.3g over %d inputs\n",
                         input_encoding_name(inputs), output_encoding_name(outputs), err, compared);
         }
+    // Residual outputs of a sky with multiple scattering: the multiply
+    // scattered light's term and its constants in the uniform block, in
+    // desktop GLSL and in GLSL ES.
+    for (ExportLanguage lang : {ExportLanguage::Glsl, ExportLanguage::GlslEs}) {
+        const NeuralSky net = encoded_network(InputEncoding::Horizon, OutputEncoding::Residual, true);
+        int compared = 0;
+        const double err = glsl_network_error(net, &compared, lang);
+        EXPECT_GT(compared, 3000);
+        EXPECT_LT(err, 1e-5);
+        std::printf("%s network (residual outputs, multiple scattering) vs mlp_hd.h: max relative error %.3g over %d "
+                    "inputs\n",
+                    lang == ExportLanguage::Glsl ? "GLSL" : "GLSL ES", err, compared);
+    }
 }
 
 // The uniform-block source depends on the topology and the encoding only.

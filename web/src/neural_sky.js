@@ -65,6 +65,7 @@ function decodeLog(x, max, logRange) {
 // operation for operation (kResidualSteps, kResidualRange there).
 const RESIDUAL_STEPS = 4;
 const RESIDUAL_SCALE = f(2 / f(0.5 * ENCODE_SCALE));
+const MULTIPLE_LOG_RANGE = f(27.6310211); // kMultipleLogRange: 12 decades
 
 function periapsisAltitude(h, R0, cosChi) {
   const s2 = f(f(1 - cosChi) * f(1 + cosChi));
@@ -124,7 +125,14 @@ export class NeuralSky {
           component: term.component });
       }
     }
-    const outputs = factored ? 3 * this.terms.length : 4;
+    // Residual outputs of a sky with multiple scattering: the multiply scattered light, after the terms.
+    this.multipleMax = null;
+    if (e.multiple_max !== undefined) {
+      if (this.outputKind !== 'residual' || !Array.isArray(e.multiple_max) || e.multiple_max.length !== 3)
+        fail('encoding.multiple_max must be [r, g, b], with residual outputs');
+      this.multipleMax = e.multiple_max.map((m) => finiteNumber(m, 'encoding.multiple_max'));
+    }
+    const outputs = factored ? 3 * this.terms.length + (this.multipleMax ? 3 : 0) : 4;
     const a = d.atmosphere ?? fail('no atmosphere');
     if (this.outputKind === 'residual') {
       // The march's atmosphere: its exponential components, and per term its component's scattering.
@@ -344,6 +352,10 @@ export class NeuralSky {
         for (let ch = 0; ch < 3; ++ch)
           c[ch] = f(c[ch] + f(f(p * base[3 * k + ch]) * f(Math.exp(f(RESIDUAL_SCALE * f(enc[3 * k + ch] - 0.5))))));
       });
+      if (this.multipleMax) {
+        const at = 3 * this.terms.length;
+        for (let ch = 0; ch < 3; ++ch) c[ch] = f(c[ch] + decodeLog(enc[at + ch], f(this.multipleMax[ch]), MULTIPLE_LOG_RANGE));
+      }
       return c;
     }
     if (this.outputKind === 'phase-factored') {

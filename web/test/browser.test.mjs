@@ -36,7 +36,8 @@ export async function openPage(url, onConsole) {
 test('NeuralSky draws the network of the weights file, and skybakeLighting lights baked data with its SH light', async () => {
   const dir = mkdtempSync(join(tmpdir(), 'skybake-web-'));
   const networks = [];
-  for (const name of ['v3_earth_default.json', 'v1_paper.json', 'v1_shared_linear.json', 'v3_earth_residual.json']) {
+  for (const name of ['v3_earth_default.json', 'v1_paper.json', 'v1_shared_linear.json', 'v3_earth_residual.json',
+    'v3_earth_multiple.json']) {
     const weightsFile = join(process.env.SKYBAKE_TEST_DATA, 'neural', name);
     const glslFile = join(dir, `${name}.glsl`);
     execFileSync(process.env.SKYBAKE_CLI, ['sky', 'export', weightsFile, '--format', 'glsl-es', '-o', glslFile], { stdio: 'ignore' });

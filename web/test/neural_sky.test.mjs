@@ -59,6 +59,7 @@ for (const [file, what] of [
   ['neural/v1_shared_linear.json', 'a shared network, linear brightness'],
   ['neural/v3_earth_default.json', 'horizon inputs, phase-factored outputs'],
   ['neural/v3_earth_residual.json', 'the default: horizon inputs, residual outputs'],
+  ['neural/v3_earth_multiple.json', 'the default with multiple scattering: residual outputs and their term'],
 ]) {
   test(`${file} (${what}) matches the library`, { skip: !cli || !data ? 'SKYBAKE_CLI and SKYBAKE_TEST_DATA not set' : false }, () => {
     const model = join(data, file);
