@@ -90,11 +90,9 @@ void BM_NeuralBatch(benchmark::State& state) {
     state.counters["vs_tables"] = rate / base;
 }
 
-void BM_NeuralScalarOneCore(benchmark::State& state) {
-    const double base = tables_rate();
-    const NeuralSky net = random_net(kTopologies[state.range(0)]);
-    state.SetLabel(fmt::format("{} ({} weights)", net.topology.name(), net.topology.weight_count()));
-    const neural::MlpHD hd = neural::make_mlp_hd(net); // what a CUDA kernel or a shader evaluates
+// The scalar pass of `hd` over the samples, one core: samples/s and the
+// ratio to the tables' rate `base`.
+void scalar_pass(benchmark::State& state, const neural::MlpHD& hd, double base) {
     std::vector<glm::vec3> out(samples().size());
     const auto t0 = std::chrono::steady_clock::now();
     for (auto _ : state) {
@@ -108,6 +106,14 @@ void BM_NeuralScalarOneCore(benchmark::State& state) {
     const double rate = double(samples().size()) * double(state.iterations()) / s;
     state.counters["samples_per_s"] = rate;
     state.counters["vs_tables"] = rate / base;
+}
+
+void BM_NeuralScalarOneCore(benchmark::State& state) {
+    const double base = tables_rate();
+    const NeuralSky net = random_net(kTopologies[state.range(0)]);
+    state.SetLabel(fmt::format("{} ({} weights)", net.topology.name(), net.topology.weight_count()));
+    const neural::MlpHD hd = neural::make_mlp_hd(net); // what a CUDA kernel or a shader evaluates
+    scalar_pass(state, hd, base);
 }
 
 // The default network's size with phase-factored (0) or residual (1) outputs,
@@ -128,19 +134,7 @@ void BM_NeuralScalarOutputs(benchmark::State& state) {
     state.SetLabel(fmt::format("shared:16x12, horizon/{} ({} weights)", output_encoding_name(net.encoding.outputs),
                                net.topology.weight_count()));
     const neural::MlpHD hd = neural::make_mlp_hd(net);
-    std::vector<glm::vec3> out(samples().size());
-    const auto t0 = std::chrono::steady_clock::now();
-    for (auto _ : state) {
-        for (std::size_t i = 0; i < samples().size(); ++i) {
-            const SkySample& x = samples()[i];
-            out[i] = neural::neural_sky(hd, x.cos_view_zenith, x.cos_view_sun, x.cos_sun_zenith, x.density);
-        }
-        benchmark::DoNotOptimize(out.data());
-    }
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const double rate = double(samples().size()) * double(state.iterations()) / s;
-    state.counters["samples_per_s"] = rate;
-    state.counters["vs_tables"] = rate / base;
+    scalar_pass(state, hd, base);
 }
 
 void BM_TrainPaper800k(benchmark::State& state) {

@@ -126,6 +126,20 @@ namespace {
 
 using Constant = std::function<std::string(float)>;
 
+// mlp_hd.h's view_ray_at up to the ray's length: the observer's altitude
+// PREFIXh (from `altitude`, clamped to the atmosphere), PREFIXr, PREFIXrho and
+// PREFIXrc = r cos_view_zenith, PREFIXarc = |PREFIXrc|.
+void emit_observer(std::ostringstream& o, const std::string& p, const std::string& altitude, const std::string& R0,
+                   const std::string& top, const Dialect& d) {
+    const std::string zero = lit(0.0f, d), two = lit(2.0f, d);
+    o << fmt::format("    float {}h = {};\n", p, altitude);
+    o << fmt::format("    {0}h = {0}h > {1} ? ({0}h < {2} ? {0}h : {2}) : {1};\n", p, zero, top);
+    o << fmt::format("    float {0}r = {1} + {0}h;\n", p, R0);
+    o << fmt::format("    float {0}rho = {1}({0}h * ({2} * {3} + {0}h));\n", p, d.shader ? "sqrt" : "sqrtf", two, R0);
+    o << fmt::format("    float {0}rc = {0}r * cos_view_zenith;\n", p);
+    o << fmt::format("    float {0}arc = {1}({0}rc);\n", p, d.shader ? "abs" : "fabsf");
+}
+
 // The horizon inputs of mlp_hd.h's encode_inputs, operation for operation
 // (the C version rounds as the library's scalar pass does).
 void emit_horizon_inputs(std::ostringstream& o, const MlpHD& m, const Dialect& d, const Constant& constant) {
@@ -141,12 +155,7 @@ void emit_horizon_inputs(std::ostringstream& o, const MlpHD& m, const Dialect& d
         return fmt::format("({3} + {4} * ({0} > {1} ? ({0} < {2} ? {0} : {2}) : {1}))", x, zero, one, gap, span);
     };
     o << "    // horizon inputs: ray length split at the horizon, cos b0, cos t0, altitude coordinate\n";
-    o << fmt::format("    float h = -{} * {}(density);\n", scale, log_);
-    o << fmt::format("    h = h > {} ? (h < {} ? h : {}) : {};\n", zero, top, top, zero);
-    o << fmt::format("    float r = {} + h;\n", R0);
-    o << fmt::format("    float rho = {}(h * ({} * {} + h));\n", sqrt_, two, R0);
-    o << "    float rc = r * cos_view_zenith;\n";
-    o << fmt::format("    float arc = {}(rc);\n", abs_);
+    emit_observer(o, "", fmt::format("-{} * {}(density)", scale, log_), R0, top, d);
     o << "    float in0;\n";
     o << fmt::format("    if (cos_view_zenith < {} && arc >= rho) {{\n", zero);
     o << "        float disc = (arc - rho) * (arc + rho);\n";
@@ -301,13 +310,10 @@ void emit_analytic_terms(std::ostringstream& o, const std::string& name, const M
     const char* ch = "rgb";
     o << "    // residual outputs: the analytic single scattering A per term (skybake's analytic_terms)\n";
     o << fmt::format("    float a_u = (density - {0}) / (density + {0}), a_u2 = a_u * a_u;\n", one);
-    o << fmt::format("    float a_h = -{} * (density > {} ? {} * a_u * ({} + a_u2 * ({} + a_u2 * {})) : {}(density));\n",
-                     scale, lit(0.97f, d), two, one, lit(0.333333343f, d), lit(0.2f, d), log_);
-    o << fmt::format("    a_h = a_h > {0} ? (a_h < {1} ? a_h : {1}) : {0};\n", zero, top);
-    o << fmt::format("    float a_r = {} + a_h;\n", R0);
-    o << fmt::format("    float a_rho = {}(a_h * ({} * {} + a_h));\n", sqrt_, two, R0);
-    o << "    float a_rc = a_r * cos_view_zenith;\n";
-    o << fmt::format("    float a_arc = {}(a_rc);\n", abs_);
+    emit_observer(o, "a_",
+                  fmt::format("-{} * (density > {} ? {} * a_u * ({} + a_u2 * ({} + a_u2 * {})) : {}(density))", scale,
+                              lit(0.97f, d), two, one, lit(0.333333343f, d), lit(0.2f, d), log_),
+                  R0, top, d);
     o << "    float a_d;\n";
     o << fmt::format("    if (cos_view_zenith < {} && a_arc >= a_rho) {{\n", zero);
     o << "        float disc = (a_arc - a_rho) * (a_arc + a_rho);\n";
