@@ -204,6 +204,17 @@ std::string phase_expression(int kind, const std::string& g, float g_value, bool
     }
 }
 
+// Opens the block of phase term k: its name, and p = its phase function at
+// cos_view_sun (g from `constant`, the term's first constant).
+void open_phase_term(std::ostringstream& o, const NeuralSky& net, const MlpHD& m, int k, const Dialect& d,
+                     const Constant& constant) {
+    const std::string g = constant(m.term_g[k]);
+    const bool lit_g = g.find('[') == std::string::npos;
+    o << fmt::format("    {{ // {} ({})\n", net.encoding.terms[std::size_t(k)].component,
+                     phase_function_name(net.encoding.terms[std::size_t(k)].phase));
+    o << fmt::format("        float p = {};\n", phase_expression(m.term_phase[k], g, m.term_g[k], lit_g, d));
+}
+
 // I = Σ_k P_k(cos b0) S_k with each channel of S_k = max · e^(D (x' − 1)), 0 below the offset.
 void emit_phase_factored_decoding(std::ostringstream& o, const NeuralSky& net, const MlpHD& m, const Dialect& d,
                                   const std::vector<std::string>& outputs, const std::string& log_range,
@@ -213,11 +224,7 @@ void emit_phase_factored_decoding(std::ostringstream& o, const NeuralSky& net, c
     o << "    // decoding: per phase term, the exact phase function times S (log-encoded per channel)\n";
     o << fmt::format("    float cr = {0}, cg = {0}, cb = {0};\n", zero);
     for (int k = 0; k < m.terms; ++k) {
-        const std::string g = constant(m.term_g[k]);
-        const bool lit_g = g.find('[') == std::string::npos;
-        o << fmt::format("    {{ // {} ({})\n", net.encoding.terms[std::size_t(k)].component,
-                         phase_function_name(net.encoding.terms[std::size_t(k)].phase));
-        o << fmt::format("        float p = {};\n", phase_expression(m.term_phase[k], g, m.term_g[k], lit_g, d));
+        open_phase_term(o, net, m, k, d, constant);
         const char* ch[] = {"cr", "cg", "cb"};
         for (int c = 0; c < 3; ++c) {
             const std::string mx = constant(m.term_max[k][c]);
@@ -447,11 +454,7 @@ void emit_residual_decoding(std::ostringstream& o, const NeuralSky& net, const M
     const char* acc[] = {"cr", "cg", "cb"};
     const char* ch = "rgb";
     for (int k = 0; k < m.terms; ++k) {
-        const std::string g = constant(m.term_g[k]);
-        const bool lit_g = g.find('[') == std::string::npos;
-        o << fmt::format("    {{ // {} ({})\n", net.encoding.terms[std::size_t(k)].component,
-                         phase_function_name(net.encoding.terms[std::size_t(k)].phase));
-        o << fmt::format("        float p = {};\n", phase_expression(m.term_phase[k], g, m.term_g[k], lit_g, d));
+        open_phase_term(o, net, m, k, d, constant);
         for (int c = 0; c < 3; ++c)
             o << fmt::format("        {} += p * A{}{} * {}({} * ({} - {}));\n", acc[c], k, ch[c], d.exp, scale,
                              outputs[std::size_t(3 * k + c)], half);
