@@ -16,6 +16,7 @@
 #include <glm/vec3.hpp>
 
 #include "core/hd.h"
+#include "sky/planet_shadow_hd.h"
 #include "sky/sky_hd.h"
 
 namespace skybake::neural {
@@ -220,26 +221,12 @@ SKYBAKE_HD_INLINE bool shadow_span(float r, float rho, float mu, float nu, float
     lo = 0.0f;
     hi = d;
     const float c = r * mu_s;
-    if (nu > 0.0f) {
-        const float t = -c / nu;
-        hi = hi < t ? hi : t;
-    } else if (nu < 0.0f) {
-        const float t = -c / nu;
-        lo = lo > t ? lo : t;
-    } else if (!(c < 0.0f)) {
+    if (!sky::narrow_to_negative(c, nu, lo, hi))
         return false;
-    }
     const float A = (1.0f - nu) * (1.0f + nu), B = 2.0f * r * (mu - mu_s * nu), C = (rho - c) * (rho + c);
     if (A <= 1e-12f) { // along the sun: B t + C < 0
-        if (B > 0.0f) {
-            const float t = -C / B;
-            hi = hi < t ? hi : t;
-        } else if (B < 0.0f) {
-            const float t = -C / B;
-            lo = lo > t ? lo : t;
-        } else if (!(C < 0.0f)) {
+        if (!sky::narrow_to_negative(C, B, lo, hi))
             return false;
-        }
     } else {
         const float D = B * B - 4.0f * A * C;
         if (!(D > 0.0f))
