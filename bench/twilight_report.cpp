@@ -4,12 +4,14 @@
 // horizon towards and away from the sun (docs/sky.md, "Error over a grid of
 // views", is this program's output).
 //
-//   twilight_report [--paths N] [--reference FILE] [--nmus N] [--mu-s-min C] [--sphere N] [--nu N] [--orders N]
+//   twilight_report [--paths N] [--sunlit-air] [--reference FILE] [--nmus N] [--mu-s-min C] [--sphere N] [--nu N] [--orders N]
 //   twilight_report --night [--nmus N] [--mu-s-min C] [--orders N]
 //   (--altitude H and --sun S keep only the views at H km, at S°)
 //
 // The reference is the exact single-scattering quadrature plus the path
-// tracer's orders 2 and up (all of them). --reference FILE reads it from FILE
+// tracer's orders 2 and up (all of them); --sunlit-air traces them with
+// next events through the sunlit air (NextEvent::SunlitAir), which resolves
+// the sky beyond the terminator. --reference FILE reads it from FILE
 // when FILE exists, else traces it and writes it there, so table settings can
 // be compared against one reference. The horizon is the direction 1° above
 // the geometric horizon (for an observer above the atmosphere, 1° above the
@@ -90,11 +92,16 @@ int main(int argc, char** argv) {
     MultipleScatteringResolution res;
     int orders = 4;
     bool night = false;
+    NextEvent next_event = NextEvent::Sun;
     double only_altitude = -1.0, only_sun = 1000.0;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--night") {
             night = true;
+            continue;
+        }
+        if (a == "--sunlit-air") {
+            next_event = NextEvent::SunlitAir;
             continue;
         }
         const char* value = i + 1 < argc ? argv[i + 1] : nullptr;
@@ -160,6 +167,7 @@ int main(int argc, char** argv) {
         PathTracerOptions pt;
         pt.paths = paths;
         pt.min_order = 2;
+        pt.next_event = next_event;
         bool traced = false;
         for (const View& v : views) {
             if (ref.count(key(v)))

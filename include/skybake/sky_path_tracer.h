@@ -14,6 +14,19 @@
 // not counted (as in SkyModel). Results are per unit sun irradiance, 1/sr,
 // each channel traced on its own.
 //
+// Next events: by default each scattering event adds the sun (next-event
+// estimation). With NextEvent::SunlitAir it adds instead the light that
+// arrives along the path's next direction after one more scattering in sunlit
+// air (or one reflection of the sun on the ground at the ray's end), from the
+// exact single-scattering quadrature along that ray: the same expectation,
+// but a shadowed point now sees the lit air beyond the terminator through
+// every direction it samples, not only through the rare paths that collide
+// there. In the planet's shadow the directions are drawn from a one-sample
+// mixture of the phase functions and a band around the local horizon towards
+// the sun, where the lit air lies at twilight. This is the reference for
+// deep twilight and night (docs/sky.md, "At night"); each event costs an
+// adaptive quadrature, so it is slower per path.
+//
 // Deterministic: path i of channel c draws from SplitMix64 seeded by (seed, c, i),
 // and partial sums are added in a fixed order, whatever the thread count.
 #pragma once
@@ -26,11 +39,17 @@
 
 namespace skybake {
 
+enum class NextEvent {
+    Sun,       // the sun at every scattering event
+    SunlitAir, // the once-scattered light along the next direction (twilight and night)
+};
+
 struct PathTracerOptions {
     std::uint64_t paths = 1u << 16; // per channel, ≥ 2
     std::uint64_t seed = 1;
     int min_order = 1;              // count scattering orders min_order..max_order (1 ≤ min ≤ max)
     int max_order = 1 << 20;
+    NextEvent next_event = NextEvent::Sun;
 };
 
 struct PathTracedRadiance {

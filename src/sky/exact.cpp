@@ -19,23 +19,15 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Altitude of the point origin + t dir, from |p|² − R0² without cancellation.
-struct RayAltitude {
-    double R0, h0, r0, mu; // origin altitude, radius and cosine to its vertical
-    RayAltitude(double R0_, const glm::dvec3& origin, const glm::dvec3& dir) : R0(R0_) {
-        r0 = glm::length(origin);
-        h0 = r0 - R0; // origin altitudes are small or the origin is far: fine in double
-        mu = glm::dot(origin, dir) / r0;
-    }
-    double operator()(double t) const {
-        const double d2 = h0 * (2.0 * R0 + h0) + t * (t + 2.0 * r0 * mu);
-        return d2 / (std::sqrt(R0 * R0 + std::max(d2, -R0 * R0)) + R0);
-    }
-    // Distance to the lowest point of the line (the tangent point).
-    double tangent() const { return -r0 * mu; }
-};
+glm::dvec3 extinction_at(const Atmosphere& atm, double h) {
+    glm::dvec3 e(0.0);
+    for (const AtmosphereComponent& c : atm.components)
+        e += c.extinction_per_km * relative_density(c, h);
+    return e;
+}
 
-// Length scale of the sharpest density profile, for the initial panels.
+} // namespace
+
 double profile_scale(const Atmosphere& atm) {
     double s = atm.top_radius_km - atm.planet_radius_km;
     for (const AtmosphereComponent& c : atm.components) {
@@ -46,15 +38,6 @@ double profile_scale(const Atmosphere& atm) {
     }
     return 0.25 * s;
 }
-
-glm::dvec3 extinction_at(const Atmosphere& atm, double h) {
-    glm::dvec3 e(0.0);
-    for (const AtmosphereComponent& c : atm.components)
-        e += c.extinction_per_km * relative_density(c, h);
-    return e;
-}
-
-} // namespace
 
 // ∫_a^b extinction(x(t)) dt along origin + t dir: optical depth per channel.
 glm::dvec3 optical_depth_exact(const Atmosphere& atm, const glm::dvec3& origin, const glm::dvec3& dir, double a,

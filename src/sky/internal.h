@@ -2,6 +2,9 @@
 // (the parts other modules share are in sky/device.h).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
+
 #include <glm/exponential.hpp>
 #include <glm/geometric.hpp>
 
@@ -9,6 +12,26 @@
 #include "sky/device.h"
 
 namespace skybake::sky {
+
+// Altitude of the point origin + t dir, from |p|² − R0² without cancellation.
+struct RayAltitude {
+    double R0, h0, r0, mu; // origin altitude, radius and cosine to its vertical
+    RayAltitude(double R0_, const glm::dvec3& origin, const glm::dvec3& dir) : R0(R0_) {
+        r0 = glm::length(origin);
+        h0 = r0 - R0; // origin altitudes are small or the origin is far: fine in double
+        mu = glm::dot(origin, dir) / r0;
+    }
+    double operator()(double t) const {
+        const double d2 = h0 * (2.0 * R0 + h0) + t * (t + 2.0 * r0 * mu);
+        return d2 / (std::sqrt(R0 * R0 + std::max(d2, -R0 * R0)) + R0);
+    }
+    // Distance to the lowest point of the line (the tangent point).
+    double tangent() const { return -r0 * mu; }
+};
+
+// A quarter of the sharpest density profile's length scale: the first panel
+// of the quadratures' graded breakpoints.
+double profile_scale(const Atmosphere& atmosphere);
 
 // Exact in-scattered radiance (1/sr, per unit irradiance) along the segment
 // from `origin_km` in unit direction `dir` for length_km, with unit sun

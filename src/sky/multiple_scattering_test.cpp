@@ -379,8 +379,9 @@ TEST(MultipleScattering, PrecomputationReportsItsProgress) {
             EXPECT_EQ(labels[i], "multiple scattering") << name;
             EXPECT_EQ(seen[i].total, seen.back().total) << name;
             EXPECT_LE(seen[i].done, seen[i].total) << name;
-            if (i > 0)
+            if (i > 0) {
                 EXPECT_GE(seen[i].done, seen[i - 1].done) << name;
+            }
             EXPECT_EQ(seen[i].finished, i + 1 == seen.size()) << name;
         }
     }
