@@ -4,14 +4,16 @@
 // horizon towards and away from the sun (docs/sky.md, "Error over a grid of
 // views", is this program's output).
 //
-//   twilight_report [--paths N] [--sunlit-air] [--reference FILE] [--nmus N] [--mu-s-min C] [--sphere N] [--nu N] [--orders N]
-//   twilight_report --night [--nmus N] [--mu-s-min C] [--orders N]
+//   twilight_report [--paths N] [--twilight-paths N] [--reference FILE] [--nmus N] [--mu-s-min C] [--sphere N] [--nu N] [--orders N]
+//   twilight_report --night [--twilight-paths N] [--nmus N] [--mu-s-min C] [--orders N]
 //   (--altitude H and --sun S keep only the views at H km, at S°)
 //
 // The reference is the exact single-scattering quadrature plus the path
-// tracer's orders 2 and up (all of them); --sunlit-air traces them with
-// next events through the sunlit air (NextEvent::SunlitAir), which resolves
-// the sky beyond the terminator. --reference FILE reads it from FILE
+// tracer's orders 2 and up (all of them): with the sun's next events and
+// --paths paths per channel (default 2^16) where the sun is up, and with next
+// events through the sunlit air (NextEvent::SunlitAir), which resolve the sky
+// beyond the terminator, and --twilight-paths (default 2^14) where it is
+// down. --reference FILE reads it from FILE
 // when FILE exists, else traces it and writes it there, so table settings can
 // be compared against one reference. The horizon is the direction 1° above
 // the geometric horizon (for an observer above the atmosphere, 1° above the
@@ -21,7 +23,8 @@
 // standard errors exceed 30% of the reference (deep twilight, where paths
 // seldom find the lit air), or that is 0 (none did), is not compared ("·"). Built as a tool, not a test:
 // the reference takes minutes. --night prints instead the orders' zenith
-// radiance at sea level for suns from 0 to −30° (how the night falls).
+// radiance at sea level for suns from 0 to −30° (how the night falls); with
+// --twilight-paths, next to the path tracer's (all orders) from −4° to −24°.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -92,16 +95,13 @@ int main(int argc, char** argv) {
     MultipleScatteringResolution res;
     int orders = 4;
     bool night = false;
-    NextEvent next_event = NextEvent::Sun;
+    std::uint64_t twilight_paths = 1u << 14;
+    bool night_reference = false;
     double only_altitude = -1.0, only_sun = 1000.0;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--night") {
             night = true;
-            continue;
-        }
-        if (a == "--sunlit-air") {
-            next_event = NextEvent::SunlitAir;
             continue;
         }
         const char* value = i + 1 < argc ? argv[i + 1] : nullptr;
@@ -111,6 +111,10 @@ int main(int argc, char** argv) {
         }
         if (a == "--paths")
             paths = std::strtoull(value, nullptr, 10);
+        else if (a == "--twilight-paths") {
+            twilight_paths = std::strtoull(value, nullptr, 10);
+            night_reference = true;
+        }
         else if (a == "--reference")
             reference_file = value;
         else if (a == "--nmus")
@@ -142,11 +146,32 @@ int main(int argc, char** argv) {
                 views.push_back(v);
         if (night) {
             const SkyModel model = multiple_model(earth, MultipleScatteringMethod::Orders, orders, res);
-            std::printf("| sun | zenith radiance at sea level (R, G, B) |\n|---|---|\n");
-            for (int deg = 0; deg >= -30; --deg) {
+            if (!night_reference) {
+                std::printf("| sun | zenith radiance at sea level (R, G, B) |\n|---|---|\n");
+                for (int deg = 0; deg >= -30; --deg) {
+                    const double mu_s = std::cos((90.0 - deg) * kDeg);
+                    const glm::dvec3 L = model.radiance_at_radius(R0, 1.0, mu_s, mu_s, SkyMethod::Exact);
+                    std::printf("| %d° | %.3g, %.3g, %.3g |\n", deg, L.x, L.y, L.z);
+                }
+                return 0;
+            }
+            // With --twilight-paths: against the path tracer, every order.
+            PathTracerOptions pt;
+            pt.paths = twilight_paths;
+            pt.next_event = NextEvent::SunlitAir;
+            std::printf("| sun | orders %d (R, G, B) | path tracer (R, G, B) | ratio | 3σ of the reference, %% |\n"
+                        "|---|---|---|---|---|\n",
+                        orders);
+            for (const int deg : {-4, -8, -12, -16, -18, -20, -24}) {
+                if (only_sun < 999.0 && double(deg) != only_sun)
+                    continue;
                 const double mu_s = std::cos((90.0 - deg) * kDeg);
                 const glm::dvec3 L = model.radiance_at_radius(R0, 1.0, mu_s, mu_s, SkyMethod::Exact);
-                std::printf("| %d° | %.3g, %.3g, %.3g |\n", deg, L.x, L.y, L.z);
+                const PathTracedRadiance m = path_trace_sky(earth, R0, 1.0, mu_s, mu_s, pt);
+                const glm::dvec3 q = L / m.mean, e = 300.0 * m.standard_error / m.mean;
+                std::printf("| %d° | %.2g, %.2g, %.2g | %.2g, %.2g, %.2g | %.2f, %.2f, %.2f | %.0f, %.0f, %.0f |\n", deg,
+                            L.x, L.y, L.z, m.mean.x, m.mean.y, m.mean.z, q.x, q.y, q.z, e.x, e.y, e.z);
+                std::fflush(stdout);
             }
             return 0;
         }
@@ -165,14 +190,15 @@ int main(int argc, char** argv) {
         }
         const SkyModel single(earth);
         PathTracerOptions pt;
-        pt.paths = paths;
         pt.min_order = 2;
-        pt.next_event = next_event;
         bool traced = false;
         for (const View& v : views) {
             if (ref.count(key(v)))
                 continue;
             const glm::dvec3 s = single.radiance_at_radius(R0 + v.altitude_km, v.mu, v.nu, v.mu_s, SkyMethod::Exact);
+            const bool sun_down = v.mu_s < 0.0;
+            pt.paths = sun_down ? twilight_paths : paths;
+            pt.next_event = sun_down ? NextEvent::SunlitAir : NextEvent::Sun;
             const PathTracedRadiance m = path_trace_sky(earth, R0 + v.altitude_km, v.mu, v.nu, v.mu_s, pt);
             ref[key(v)] = {s + m.mean, m.standard_error};
             traced = true;

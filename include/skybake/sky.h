@@ -302,7 +302,13 @@ struct MultipleScatteringResolution {
     int mu = 32;       // view-cosine nodes per half (above / below the horizon), ≥ 2
     int mu_s = 32;     // sun-cosine nodes, ≥ 2
     int nu = 8;        // view–sun cosine nodes, ≥ 2
-    int sphere = 16;   // polar samples of the sphere integrals, Gauss–Legendre in cos θ, half on each side of the horizon (an odd count loses one); azimuth: twice as many; ≥ 4
+    // Polar samples of the sphere integrals, ≥ 4; azimuths: twice as many. The
+    // orders: Gauss–Legendre in cos θ on each interval between the nadir, the
+    // geometric horizon, the horizontal and the zenith (a third each; half on
+    // each side of the horizon on the ground); Hillaire's table and the sky
+    // irradiance: midpoint bands. 24 resolves the sky's light 8–16° after
+    // sunset, 16 did not (docs/sky.md, "At night").
+    int sphere = 24;
     int psi_r = 32, psi_mu_s = 32;           // Hillaire's ψms table, ≥ 2 each
     int irradiance_r = 8, irradiance_mu_s = 64; // sky irradiance table, ≥ 2 each
     // Lowest sun cosine of the orders grid, in (−1, 0]: cos 120°, where the
