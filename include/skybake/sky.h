@@ -305,7 +305,8 @@ struct MultipleScatteringResolution {
     // Polar samples of the sphere integrals, ≥ 4; azimuths: twice as many. The
     // orders: Gauss–Legendre in cos θ on each interval between the nadir, the
     // geometric horizon, the horizontal and the zenith (a third each; half on
-    // each side of the horizon on the ground); Hillaire's table and the sky
+    // each side of the horizon on the ground; an odd count loses one node);
+    // Hillaire's table and the sky
     // irradiance: midpoint bands. 24 resolves the sky's light 8–16° after
     // sunset, 16 did not (docs/sky.md, "At night").
     int sphere = 24;

@@ -64,12 +64,14 @@ SphereRule sphere_rule(int n, double mu_horizon) {
         double lo, hi;
         int nodes;
     };
+    // Both forms hold 2·⌊n/2⌋ polar nodes (an odd n loses one), so that every
+    // radius's rule has as many directions as the ground's.
     std::vector<Span> spans;
+    const int half = std::max(1, n / 2); // n ≥ 4 (validated): 2·half − 2·third ≥ 2
     if (mu_horizon < -1e-9) {
         const int third = std::max(1, n / 3);
-        spans = {{-1.0, mu_horizon, third}, {mu_horizon, 0.0, third}, {0.0, 1.0, std::max(1, n - 2 * third)}};
+        spans = {{-1.0, mu_horizon, third}, {mu_horizon, 0.0, third}, {0.0, 1.0, 2 * half - 2 * third}};
     } else {
-        const int half = std::max(1, n / 2);
         spans = {{-1.0, mu_horizon, half}, {mu_horizon, 1.0, half}};
     }
     const double d = kPiD / double(n);
@@ -295,6 +297,7 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
                 bool ground;
                 g.node(ray * per_ray, r, mu, mu_s, nu, ground);
                 const SphereRule sphere = sphere_rule(res.sphere, -std::sqrt(std::max(0.0, 1.0 - (R0 / r) * (R0 / r))));
+                assert(sphere.dir.size() == D);
                 const glm::dvec3 view(std::sqrt(std::max(0.0, 1.0 - mu * mu)), 0.0, mu);
                 bool any = false;
                 for (std::size_t i = 0; i < D; ++i) {
