@@ -306,9 +306,8 @@ struct MultipleScatteringResolution {
     // orders: Gauss–Legendre in cos θ on each interval between the nadir, the
     // geometric horizon, the horizontal and the zenith (a third each; half on
     // each side of the horizon on the ground; an odd count loses one node);
-    // Hillaire's table and the sky
-    // irradiance: midpoint bands. 24 resolves the sky's light 8–16° after
-    // sunset, 16 did not (docs/sky.md, "At night").
+    // Hillaire's table and the sky irradiance: midpoint bands. 24 resolves
+    // the sky's light 8–16° after sunset, 16 did not (docs/sky.md, "At night").
     int sphere = 24;
     int psi_r = 32, psi_mu_s = 32;           // Hillaire's ψms table, ≥ 2 each
     int irradiance_r = 8, irradiance_mu_s = 64; // sky irradiance table, ≥ 2 each

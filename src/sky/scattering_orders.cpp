@@ -225,6 +225,16 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
     const glm::dvec3 albedo_over_pi = atm.ground_albedo / kPiD;
     const SphereRule ground_rule = sphere_rule(res.sphere, 0.0); // at r = R0
     const std::size_t D = ground_rule.dir.size();
+    // Each radius node's rule, split at its own horizon (the same for all its rays).
+    std::vector<SphereRule> radius_rules;
+    for (int ir = 0; ir < g.nr; ++ir) {
+        double r, mu, mu_s, nu;
+        bool ground;
+        g.node(std::size_t(ir) * 2u * std::size_t(g.nmu) * std::size_t(g.nmus) * std::size_t(g.nnu), r, mu, mu_s, nu,
+               ground);
+        radius_rules.push_back(sphere_rule(res.sphere, -std::sqrt(std::max(0.0, 1.0 - (R0 / r) * (R0 / r)))));
+        assert(radius_rules.back().dir.size() == D);
+    }
     const auto phase = [&](std::size_t k, double c) {
         const AtmosphereComponent& a = atm.components[k];
         return phase_function(a.phase, a.phase_g, c);
@@ -296,8 +306,7 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
                 double r, mu, mu_s, nu;
                 bool ground;
                 g.node(ray * per_ray, r, mu, mu_s, nu, ground);
-                const SphereRule sphere = sphere_rule(res.sphere, -std::sqrt(std::max(0.0, 1.0 - (R0 / r) * (R0 / r))));
-                assert(sphere.dir.size() == D);
+                const SphereRule& sphere = radius_rules[ray / (2u * std::size_t(g.nmu))];
                 const glm::dvec3 view(std::sqrt(std::max(0.0, 1.0 - mu * mu)), 0.0, mu);
                 bool any = false;
                 for (std::size_t i = 0; i < D; ++i) {
