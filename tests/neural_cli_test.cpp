@@ -107,6 +107,44 @@ TEST(NeuralCli, TrainRejectsBadFlags) {
     }
 }
 
+// An aerosol family: --aerosol-range at training, --aerosol where the network
+// is used; bad values are one-line usage errors naming the flag.
+TEST(NeuralCli, AnAerosolFamilyTakesItsAmountAtRunTime) {
+    const std::string dir = temp_dir("neural_family");
+    const std::string family = std::string(SKYBAKE_SOURCE_DIR) + "/tests/data/neural/v3_earth_family.json";
+    const std::string in = write(dir, "in.csv", "0.2,0.5,0.4,0.9\n0.05,0.9,0.3,1.0\n");
+    auto clear = run_cli({"sky", "eval", "--model", family, "--input", in, "--output", dir + "/clear.csv"});
+    auto hazy = run_cli({"sky", "eval", "--model", family, "--aerosol", "20", "--input", in, "--output", dir + "/hazy.csv"});
+    ASSERT_EQ(clear.exit_code, 0) << clear.err;
+    ASSERT_EQ(hazy.exit_code, 0) << hazy.err;
+    EXPECT_NE(read(dir + "/clear.csv"), read(dir + "/hazy.csv"));
+    auto r = run_cli({"sky", "render", "--model", family, "--aerosol", "32", "--altitude-km", "0", "--sun-elevation-deg", "10", "--size", "32x16", "-o", dir + "/hazy.png"});
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    auto c = run_cli({"sky", "export", family, "--format", "c", "-o", dir + "/sky.c"});
+    EXPECT_EQ(c.exit_code, 0) << c.err;
+    EXPECT_NE(read(dir + "/sky.c").find("float density, float aerosol, float rgb[3]"), std::string::npos);
+    for (const auto& [args, flag] : std::vector<std::pair<std::vector<std::string>, std::string>>{
+             {{"sky", "eval", "--model", family, "--aerosol", "40", "--input", in, "--output", dir + "/o.csv"},
+              "--aerosol"},
+             {{"sky", "eval", "--model", std::string(SKYBAKE_SOURCE_DIR) +
+                                             "/tests/data/neural/v3_earth_residual.json",
+               "--aerosol", "2", "--input", in, "--output", dir + "/o.csv"},
+              "--aerosol"},
+             {{"sky", "train", "--aerosol-range", "8", "-o", dir + "/w.json"}, "--aerosol-range"},
+             {{"sky", "train", "--aerosol-range", "8:2", "-o", dir + "/w.json"}, "--aerosol-range"},
+             {{"sky", "train", "--aerosol-range", "1:8", "--aerosol-component", "ozone", "-o", dir + "/w.json"},
+              "--aerosol-range"},
+             {{"sky", "train", "--aerosol-range", "1:8", "--outputs", "phase-factored", "-o", dir + "/w.json"},
+              "--aerosol-range"},
+             {{"sky", "train", "--aerosol-component", "mie", "-o", dir + "/w.json"}, "--aerosol-component"}}) {
+        auto b = run_cli(args);
+        EXPECT_EQ(b.exit_code, 2) << b.err;
+        EXPECT_EQ(b.err_lines(), 1) << b.err;
+        EXPECT_NE(b.err.find(flag), std::string::npos) << b.err;
+        EXPECT_FALSE(fs::exists(dir + "/o.csv") || fs::exists(dir + "/w.json"));
+    }
+}
+
 TEST(NeuralCli, EvalWithModelTakesTheSameCsv) {
     const std::string dir = temp_dir("neural_eval");
     const std::string in = write(dir, "in.csv",

@@ -218,6 +218,8 @@ std::string flag_for_field(const std::string& where) {
         {"brightness", "--brightness"},
         {"inputs", "--inputs"},
         {"outputs", "--outputs"},
+        {"family_component", "--aerosol-range"},
+        {"aerosol", "--aerosol"},
         {"name", "--name"},
         {"kind", "--kind"},
         {"target_triangles", "--triangles"},

@@ -76,9 +76,14 @@ struct AtmosphereFlags {
 // the table flags do not apply.
 struct ModelFlag {
     std::string path;
+    double aerosol = 1.0;
 
     void add(CLI::App& sub) {
         sub.add_option("--model", path, "Use a trained neural sky (weights JSON from `skybake sky train`)");
+        sub.add_option("--aerosol", aerosol,
+                       "With --model of an aerosol family (sky train --aerosol-range): the aerosol amount, a "
+                       "multiple of its atmosphere's")
+            ->capture_default_str();
     }
     bool active() const { return !path.empty(); }
     NeuralSky load(const CLI::App& sub, const AtmosphereFlags& atm) const {
@@ -87,7 +92,10 @@ struct ModelFlag {
         for (const char* flag : {"--method", "--table-rule", "--steps", "--uniform-steps", "--shells", "--cosines",
                                  "--paper-r", "--paper-m", "--scattering", "--multiple-method", "--scattering-orders"})
             refuse_if_given(sub, flag, "to a neural sky (--model)");
-        return load_neural_sky(path);
+        NeuralSky net = load_neural_sky(path);
+        net.aerosol = aerosol;
+        parse_flag("--aerosol", [&] { net.validate("aerosol"); return 0; });
+        return net;
     }
 };
 

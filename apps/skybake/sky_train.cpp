@@ -20,7 +20,7 @@ void add_sky_train(CLI::App& group) {
         NeuralTrainOptions t;
         // The defaults: the best network of at most 400 weights (docs/neural.md, "Size and accuracy").
         std::string topology = kDefaultTopology, inputs = "horizon", outputs = "phase-factored", brightness = "log";
-        std::string output, curve, chart, device = "cpu";
+        std::string output, curve, chart, device = "cpu", aerosol_range, aerosol_component = "mie";
         double log_range_decades = 6.0;
         int steps = kTrainingTargetSteps;
         bool json = false;
@@ -74,6 +74,12 @@ void add_sky_train(CLI::App& group) {
         ->capture_default_str();
     sub->add_option("--curve", o->curve, "Write the learning curve as CSV");
     sub->add_option("--chart", o->chart, "Write the learning curve as a PNG chart");
+    sub->add_option("--aerosol-range", o->aerosol_range,
+                    "MIN:MAX: train one network for a family of atmospheres whose aerosol amount, a multiple of the "
+                    "atmosphere's, is an input chosen at run time (sky eval/render --aerosol)");
+    sub->add_option("--aerosol-component", o->aerosol_component,
+                    "With --aerosol-range: the scattering component whose amount varies")
+        ->capture_default_str();
     sub->add_option("-o,--output", o->output, "Weights file (JSON)")->required();
     add_json_flag(*sub, o->json);
     sub->callback([o, sub] {
@@ -105,6 +111,22 @@ void add_sky_train(CLI::App& group) {
         } else
             o->t.outputs = default_output_encoding(atm);
         o->t.log_range = o->log_range_decades * std::log(10.0);
+        if (!o->aerosol_range.empty()) {
+            const std::size_t colon = o->aerosol_range.find(':');
+            char* end = nullptr;
+            const std::string a = o->aerosol_range.substr(0, colon);
+            const std::string b = colon == std::string::npos ? "" : o->aerosol_range.substr(colon + 1);
+            const double lo = std::strtod(a.c_str(), &end);
+            const bool a_ok = !a.empty() && *end == '\0';
+            const double hi = std::strtod(b.c_str(), &end);
+            if (colon == std::string::npos || !a_ok || b.empty() || *end != '\0')
+                throw UsageError(fmt::format("'{}' is not MIN:MAX (e.g. 1:32)", o->aerosol_range), "--aerosol-range");
+            o->t.family_component = o->aerosol_component;
+            o->t.aerosol_min = lo;
+            o->t.aerosol_max = hi;
+        } else {
+            refuse_if_given(*sub, "--aerosol-component", "without --aerosol-range");
+        }
         if (!given(*sub, "--batch"))
             o->t.batch = std::min<std::size_t>(o->t.batch, o->t.samples);
         else if (o->t.batch > o->t.samples)
@@ -116,7 +138,15 @@ void add_sky_train(CLI::App& group) {
         opts.tables = kTrainingTargetTables;
         const SkyModel model(atm, opts);
         std::vector<LearningCurvePoint> curve;
-        const NeuralSky net = train_neural_sky(model, o->t, &curve);
+        const NeuralSky net = [&] {
+            try {
+                return train_neural_sky(model, o->t, &curve);
+            } catch (const Error& e) {
+                if (e.where() == "family_component") // the family the flags ask for cannot be trained
+                    throw UsageError(e.message(), "--aerosol-range");
+                throw;
+            }
+        }();
         OutputSet files; // all three, or none
         save_neural_sky(files.stage(o->output), net);
         if (!o->curve.empty())
@@ -132,9 +162,13 @@ void add_sky_train(CLI::App& group) {
             atm.scattering == Scattering::Multiple
                 ? fmt::format("total radiance, single + multiple ({})", multiple_scattering_method_name(atm.multiple_method))
                 : std::string("single-scattered radiance");
-        info("trained {} ({} weights) on {} samples of '{}' ({}) in {:.1f} s ({} threads): held-out RMS {:.4g}, "
+        const std::string family =
+            net.encoding.has_family() ? fmt::format(", {} amount {:g} to {:g}", net.encoding.family_component,
+                                                    net.encoding.aerosol_min, net.encoding.aerosol_max)
+                                      : std::string();
+        info("trained {} ({} weights) on {} samples of '{}'{} ({}) in {:.1f} s ({} threads): held-out RMS {:.4g}, "
              "mean relative error {:.3g}% -> {}",
-             net.topology.name(), net.topology.weight_count(), s.samples, atm.name, target, s.seconds, s.threads,
+             net.topology.name(), net.topology.weight_count(), s.samples, atm.name, family, target, s.seconds, s.threads,
              s.heldout_rms, 100.0 * s.heldout_mean_relative, o->output);
         // A network whose outputs all died (too large a first step for its
         // width: 0.02 for shared:128x128) is saved, but said plainly. Dead
@@ -154,6 +188,9 @@ void add_sky_train(CLI::App& group) {
                         {"brightness", o->brightness},
                         {"inputs", input_encoding_name(net.encoding.inputs)},
                         {"outputs", output_encoding_name(net.encoding.outputs)},
+                        {"aerosol_range", net.encoding.has_family()
+                                              ? nlohmann::json{net.encoding.aerosol_min, net.encoding.aerosol_max}
+                                              : nlohmann::json(nullptr)},
                         {"samples", s.samples},
                         {"adam_epochs", s.adam_epochs},
                         {"lm_iterations", s.lm_iterations},

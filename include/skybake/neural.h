@@ -49,6 +49,7 @@ struct NeuralTopology {
     std::vector<int> hidden{8, 4}; // widths of the hidden layers: 1 to 7 layers, each 1 to 128 wide
     bool shared = false;           // false: one independent sub-network per output; true: one with every output
     int outputs = 4;               // encoded outputs (NeuralEncoding::output_count()): 4, or 3 per phase term
+    int inputs = 4;                // the sky function's 4 arguments, 5 with an aerosol family's amount
 
     int subnet_count() const { return shared ? 1 : outputs; }
     int outputs_per_subnet() const { return shared ? outputs : 1; }
@@ -148,6 +149,16 @@ struct NeuralEncoding {
     // (kMultipleLogRange in src/neural/mlp_hd.h).
     bool multiple = false;
     glm::dvec3 multiple_max{1.0};
+    // An atmosphere family (residual outputs of single scattering): the
+    // amount of one scattering component, the aerosol, is a fifth input,
+    // chosen at run time (NeuralSky::aerosol) as a multiple of the
+    // atmosphere's within [aerosol_min, aerosol_max]. The analytic march
+    // scales that component's coefficients by it; the network learns the
+    // rest. family_component empty: no family (four inputs).
+    std::string family_component;
+    double aerosol_min = 1.0, aerosol_max = 1.0;
+    bool has_family() const { return !family_component.empty(); }
+    int input_count() const { return has_family() ? 5 : 4; }
     int output_count() const {
         return outputs == OutputEncoding::Radiance ? 4 : 3 * int(terms.size()) + (multiple ? 3 : 0);
     }
@@ -186,6 +197,11 @@ struct NeuralSky {
     Atmosphere atmosphere;             // the atmosphere it was trained on
     SkyModelOptions sky_options;       // tables and steps of the training targets
     NeuralTrainingSummary training;
+    // Run time, not saved: the aerosol amount of a family network, as a
+    // multiple of its atmosphere's, in [encoding.aerosol_min, aerosol_max];
+    // must be 1 for a network without a family. Every evaluator follows it
+    // (the CPU and CUDA passes, the renderers, the uniform block).
+    double aerosol = 1.0;
 
     // Throws skybake::Error naming `where` if the topology, the weight count,
     // a weight or an encoding constant is invalid.
@@ -201,7 +217,8 @@ NeuralSky neural_sky_from_json(std::string_view text, const std::string& where =
 NeuralSky load_neural_sky(const std::filesystem::path& path);
 void save_neural_sky(const std::filesystem::path& path, const NeuralSky& net); // atomic write
 
-// The reference model the network approximates (its atmosphere and options).
+// The reference model the network approximates (its atmosphere and options;
+// for an aerosol family, the atmosphere at the network's aerosol amount).
 SkyModel neural_reference_model(const NeuralSky& net);
 
 // [SECTION] Inference ---------------------------------------------------------------
@@ -263,6 +280,11 @@ struct NeuralTrainOptions {
     // model's table path on the GPU (evaluate_sky_cuda); the optimiser runs
     // on the CPU either way.
     Device device = Device::Cpu;
+    // An aerosol family (NeuralEncoding::family_component): each sample's
+    // amount of this component is drawn log-uniformly in [aerosol_min,
+    // aerosol_max] times the atmosphere's. Empty: one atmosphere.
+    std::string family_component;
+    double aerosol_min = 1.0, aerosol_max = 1.0;
 };
 
 // One point of the learning curve: after Adam epoch `epoch` (phase "adam") or

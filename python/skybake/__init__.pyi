@@ -156,6 +156,8 @@ class NeuralSky:
     weights: F32
     atmosphere: Atmosphere
     training: dict[str, float]
+    aerosol_range: Optional[tuple[float, float]]
+    aerosol: float
     def to_json(self) -> str: ...
     @staticmethod
     def from_json(text: str) -> NeuralSky: ...
@@ -208,6 +210,7 @@ def train_sky(
     table_rule: str = "refined",
     steps: int = 64,
     device: str = "cpu",
+    aerosol_range: Optional[tuple[float, float]] = None,
     progress: Progress = None,
 ) -> NeuralSky: ...
 

@@ -109,6 +109,24 @@ void bind_sky(py::module_& m) {
             },
             "(W,) float32, a copy, in the layout of skybake/neural.h.")
         .def_readonly("atmosphere", &NeuralSky::atmosphere)
+        .def_property_readonly(
+            "aerosol_range",
+            [](const NeuralSky& n) -> py::object {
+                if (!n.encoding.has_family())
+                    return py::none();
+                return py::make_tuple(n.encoding.aerosol_min, n.encoding.aerosol_max);
+            },
+            "(min, max) of an aerosol family's amount (train_sky(aerosol_range=...)), else None.")
+        .def_property(
+            "aerosol", [](const NeuralSky& n) { return n.aerosol; },
+            [](NeuralSky& n, double a) {
+                NeuralSky t = n;
+                t.aerosol = a;
+                t.validate("neural sky");
+                n.aerosol = a;
+            },
+            "The aerosol amount of a family network, a multiple of its atmosphere's, within aerosol_range; "
+            "1 for others. Every evaluator (Sky.network, export's uniform data) follows it.")
         .def_property_readonly("training",
                                [](const NeuralSky& n) {
                                    py::dict d;
@@ -229,7 +247,7 @@ void bind_sky(py::module_& m) {
         [](Atmosphere atmosphere, const std::string& topology, const std::string& inputs,
            std::optional<std::string> outputs, std::size_t samples, int adam_epochs, int lm_iterations,
            std::uint64_t seed, const std::string& brightness, const std::string& table_rule, int steps,
-           const std::string& device, py::object progress) {
+           const std::string& device, std::optional<std::pair<double, double>> aerosol_range, py::object progress) {
             atmosphere.table_rule = parse_table_rule(table_rule, "table_rule");
             atmosphere.validate();
             if (steps < 1 || steps > 4096)
@@ -246,6 +264,11 @@ void bind_sky(py::module_& m) {
             // As `sky train`: default_output_encoding (residual for single scattering).
             o.outputs = outputs ? parse_output_encoding(*outputs, "outputs") : default_output_encoding(atmosphere);
             o.device = parse_device(device);
+            if (aerosol_range) {
+                o.family_component = "mie";
+                o.aerosol_min = aerosol_range->first;
+                o.aerosol_max = aerosol_range->second;
+            }
             o.progress = true; // events go to the call's callback, never to a bar
             if (samples < 1000)
                 throw Error("at least 1000 training samples, got " + std::to_string(samples), "samples");
@@ -263,11 +286,12 @@ void bind_sky(py::module_& m) {
         py::arg("outputs") = py::none(), py::arg("samples") = 800000,
         py::arg("adam_epochs") = 60, py::arg("lm_iterations") = 20, py::arg("seed") = 1,
         py::arg("brightness") = "log", py::arg("table_rule") = "refined", py::arg("steps") = kTrainingTargetSteps,
-        py::arg("device") = "cpu", py::arg("progress") = py::none(),
+        py::arg("device") = "cpu", py::arg("aerosol_range") = py::none(), py::arg("progress") = py::none(),
         "Trains a network on the table path of `atmosphere` (Adam, then Levenberg–Marquardt), as "
         "`skybake sky train`: by default the best small network (shared:16x12, horizon inputs, residual "
         "outputs; radiance outputs with multiple scattering), targets from the refined 512 x 256 tables with 64 "
-        "steps. The seed's network: topology='paper', inputs='seed', outputs='radiance', brightness='linear' "
+        "steps. aerosol_range=(min, max): one network for the family of atmospheres whose 'mie' amount is that "
+        "multiple of the atmosphere's, chosen at run time (NeuralSky.aerosol). The seed's network: topology='paper', inputs='seed', outputs='radiance', brightness='linear' "
         "(and table_rule='as-published', steps=16 for its targets). Deterministic for a seed. "
         "topology: 'paper' (324 weights), 'independent:16x16', 'shared:64x64', ...");
 }

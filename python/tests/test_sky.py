@@ -77,6 +77,26 @@ def test_network_round_trip(tiny_net, tmp):
         skybake.load_neural_sky(path)
 
 
+def test_an_aerosol_family_takes_its_amount_at_run_time(earth):
+    net = skybake.train_sky(earth, samples=4000, adam_epochs=2, lm_iterations=0, seed=3, aerosol_range=(1.0, 16.0))
+    again = skybake.train_sky(earth, samples=4000, adam_epochs=2, lm_iterations=0, seed=3, aerosol_range=(1.0, 16.0))
+    np.testing.assert_array_equal(again.weights, net.weights)
+    assert net.aerosol_range == (1.0, 16.0) and net.aerosol == 1.0
+    samples = skybake.draw_sky_samples(200, seed=4)
+    clear = skybake.Sky.network(net).evaluate(samples)
+    net.aerosol = 12.0
+    hazy = skybake.Sky.network(net).evaluate(samples)
+    assert np.abs(hazy - clear).max() > 0.0
+    assert "float aerosol" in net.export("c")
+    with pytest.raises(skybake.Error, match="aerosol"):
+        net.aerosol = 20.0
+    assert net.aerosol == 12.0
+    plain = skybake.train_sky(earth, samples=2000, adam_epochs=1, lm_iterations=0)
+    assert plain.aerosol_range is None
+    with pytest.raises(skybake.Error, match="aerosol"):
+        plain.aerosol = 2.0
+
+
 def test_training_is_deterministic(earth, tiny_net):
     again = skybake.train_sky(earth, topology="paper", inputs="seed", outputs="radiance", brightness="linear",
                               samples=4000, adam_epochs=2, lm_iterations=1, seed=5)

@@ -5,6 +5,10 @@
 // model's marching sum.
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <optional>
+
+#include <fmt/format.h>
 
 #include <glm/geometric.hpp>
 
@@ -37,7 +41,7 @@ ErrorStats error_stats(std::vector<double>& e) {
 
 NeuralErrorReport neural::measure_approximation_error(const SkyModel& model, double max_n,
                                                      const NeuralErrorOptions& o, const BatchSky& evaluate,
-                                                     const RenderSky& render) {
+                                                     const RenderSky& render, const NeuralEncoding* family) {
     if (o.samples < 1 || o.samples > (std::size_t(1) << 28))
         throw Error("the number of samples must be 1 to 2^28", "samples");
     if (o.views && (o.view_width < 1 || o.view_height < 1 || o.view_width > 4096 || o.view_height > 4096))
@@ -49,8 +53,16 @@ NeuralErrorReport neural::measure_approximation_error(const SkyModel& model, dou
     const auto measure = [&](const std::vector<SkySample>& samples, ErrorStats& all_s, ErrorStats& day_s,
                              ErrorStats& twilight_s, ErrorStats& night_s) {
         std::vector<glm::vec3> ref(samples.size()), got(samples.size());
-        evaluate_sky(model, samples, ref, SkyMethod::Tables);
-        evaluate(samples, got);
+        std::vector<float> aerosol;
+        if (family) { // each sample's amount, from a stream of the held-out seed and the set's size
+            aerosol = draw_aerosol(*family, samples.size(), o.seed ^ (std::uint64_t(samples.size()) << 20));
+            std::vector<glm::vec3> split;
+            scaled_sky_targets(model, samples, aerosol, family_component_index(*family, model.atmosphere()), split,
+                               ref);
+        } else {
+            evaluate_sky(model, samples, ref, SkyMethod::Tables);
+        }
+        evaluate(samples, aerosol, got);
         std::vector<double> all, day, twilight, night;
         for (std::size_t i = 0; i < samples.size(); ++i) {
             const glm::dvec3 r(ref[i]), g(got[i]);
@@ -77,18 +89,28 @@ NeuralErrorReport neural::measure_approximation_error(const SkyModel& model, dou
         if (!o.views_dir.empty())
             std::filesystem::create_directories(o.views_dir);
         double sum = 0.0, mn = INFINITY;
-        for (const PublishedView& v : published_views(o.view_width, o.view_height)) {
-            const Image a = render_sky(model, v.settings);
-            const Image b = render(v.settings);
-            ToneMap tm;
-            tm.exposure_ev = float(auto_exposure_ev(a));
-            const double psnr = image_psnr_db(a, b, tm);
-            rep.views.push_back({v.name, psnr});
-            sum += psnr;
-            mn = std::min(mn, psnr);
-            if (!o.views_dir.empty()) {
-                save_image(o.views_dir / (v.name + "_reference.png"), a, tm);
-                save_image(o.views_dir / (v.name + "_neural.png"), b, tm);
+        // A family's views at the ends of its range and its geometric middle.
+        std::vector<double> amounts{1.0};
+        if (family)
+            amounts = {family->aerosol_min, std::sqrt(family->aerosol_min * family->aerosol_max), family->aerosol_max};
+        for (double amount : amounts) {
+            std::optional<SkyModel> scaled;
+            if (family)
+                scaled.emplace(scaled_atmosphere(*family, model.atmosphere(), amount), model.options());
+            for (const PublishedView& v : published_views(o.view_width, o.view_height)) {
+                const Image a = render_sky(scaled ? *scaled : model, v.settings);
+                const Image b = render(v.settings, amount);
+                ToneMap tm;
+                tm.exposure_ev = float(auto_exposure_ev(a));
+                const double psnr = image_psnr_db(a, b, tm);
+                const std::string name = family ? fmt::format("{}_aerosol_{:.3g}", v.name, amount) : v.name;
+                rep.views.push_back({name, psnr});
+                sum += psnr;
+                mn = std::min(mn, psnr);
+                if (!o.views_dir.empty()) {
+                    save_image(o.views_dir / (name + "_reference.png"), a, tm);
+                    save_image(o.views_dir / (name + "_neural.png"), b, tm);
+                }
             }
         }
         rep.mean_view_psnr_db = sum / double(rep.views.size());
@@ -99,11 +121,25 @@ NeuralErrorReport neural::measure_approximation_error(const SkyModel& model, dou
 
 NeuralErrorReport measure_neural_sky_error(const NeuralSky& net, const NeuralErrorOptions& o) {
     net.validate("neural sky");
-    const SkyModel model = neural_reference_model(net);
+    NeuralSky base = net; // a family's samples and views choose their own amounts
+    base.aerosol = 1.0;
+    const SkyModel model = neural_reference_model(base);
+    std::map<double, SkyModel> tables; // per aerosol amount of a family's views
     return neural::measure_approximation_error(
         model, net.encoding.max_n, o,
-        [&](std::span<const SkySample> s, std::span<glm::vec3> out) { evaluate_neural_sky(net, s, out); },
-        [&](const SkyRenderSettings& v) { return render_neural_sky(net, model, v); });
+        [&](std::span<const SkySample> s, std::span<const float> aerosol, std::span<glm::vec3> out) {
+            neural::evaluate_neural_sky_at(net, s, aerosol, out);
+        },
+        [&](const SkyRenderSettings& v, double aerosol) {
+            // The ground and the sun disc from the tables of the atmosphere at this amount.
+            NeuralSky at = net;
+            at.aerosol = aerosol;
+            auto it = tables.find(aerosol);
+            if (it == tables.end())
+                it = tables.emplace(aerosol, neural_reference_model(at)).first;
+            return render_neural_sky(at, it->second, v);
+        },
+        net.encoding.has_family() ? &net.encoding : nullptr);
 }
 
 } // namespace skybake

@@ -62,6 +62,18 @@ inline NeuralSky with_encoding(NeuralSky net, InputEncoding inputs, OutputEncodi
     return with_random_weights(std::move(net), seed);
 }
 
+// The same network as one of an aerosol family (its "mie" amount from lo to
+// hi, a fifth input), evaluated at `aerosol`, with new pseudo-random weights.
+// Needs residual outputs of single scattering.
+inline NeuralSky with_family(NeuralSky net, double lo, double hi, double aerosol, unsigned seed) {
+    net.encoding.family_component = "mie";
+    net.encoding.aerosol_min = lo;
+    net.encoding.aerosol_max = hi;
+    net.topology.inputs = net.encoding.input_count();
+    net.aerosol = aerosol;
+    return with_random_weights(std::move(net), seed);
+}
+
 // A model of how far the encoded outputs move when every product-sum and
 // every activation rounds differently on the two sides (the GPU's fmaf,
 // ex2.approx and rcp.approx, or expf, against the CPU's summation order and

@@ -86,7 +86,8 @@ namespace {
 // per exponential component its scale height and extinction (r, g, b), per
 // term its scattering (r, g, b), per term g, and with multiple scattering the
 // largest multiply scattered light (r, g, b); else per phase term g and
-// max S (r, g, b). This is the order the exporter reads them in.
+// max S (r, g, b). An aerosol family ends the list with its input's a and b
+// and the run-time aerosol amount. This is the order the exporter reads them in.
 std::vector<float> encoding_constants(const NeuralSky& net) {
     const MlpHD m = make_mlp_hd(net);
     std::vector<float> c{m.max_n, m.log_range};
@@ -104,6 +105,8 @@ std::vector<float> encoding_constants(const NeuralSky& net) {
             c.push_back(m.term_g[k]);
         if (m.multiple)
             c.insert(c.end(), {m.multiple_max[0], m.multiple_max[1], m.multiple_max[2]});
+        if (m.family)
+            c.insert(c.end(), {m.family_a, m.family_b, m.aerosol});
         return c;
     }
     for (int k = 0; k < m.terms; ++k)
@@ -303,14 +306,21 @@ void emit_analytic_terms(std::ostringstream& o, const std::string& name, const M
     const std::string R0 = constant(m.R0), top = constant(m.Rtop - m.R0), scale = constant(m.scale_height);
     std::vector<std::string> H(std::size_t(m.ext_count)), be(std::size_t(3 * m.ext_count)),
         bs(std::size_t(3 * m.terms));
+    // An aerosol family scales its component's coefficients by `aerosol`, as analytic_terms does.
     for (int e = 0; e < m.ext_count; ++e) {
         H[std::size_t(e)] = constant(m.ext_height[e]);
-        for (int c = 0; c < 3; ++c)
+        for (int c = 0; c < 3; ++c) {
             be[std::size_t(3 * e + c)] = constant(m.ext_beta[e][c]);
+            if (m.family && e == m.family_ext)
+                be[std::size_t(3 * e + c)] = "(" + be[std::size_t(3 * e + c)] + " * aerosol)";
+        }
     }
     for (int k = 0; k < m.terms; ++k)
-        for (int c = 0; c < 3; ++c)
+        for (int c = 0; c < 3; ++c) {
             bs[std::size_t(3 * k + c)] = constant(m.term_beta[k][c]);
+            if (m.family && k == m.family_term)
+                bs[std::size_t(3 * k + c)] = "(" + bs[std::size_t(3 * k + c)] + " * aerosol)";
+        }
     const std::string zero = lit(0.0f, d), one = lit(1.0f, d), two = lit(2.0f, d), half = lit(0.5f, d);
     const std::string sqrt_ = d.shader ? "sqrt" : "sqrtf", log_ = d.shader ? "log" : "logf";
     const std::string exp_ = d.exp, abs_ = d.shader ? "abs" : "fabsf";
@@ -361,9 +371,13 @@ void emit_analytic_terms(std::ostringstream& o, const std::string& name, const M
     o << "    a_sh = a_sh && a_lo < a_hi;\n";
     o << "    // the march over the lit parts\n";
     o << fmt::format("    float a_rho2 = a_rho * a_rho, a_2rmu = {} * a_r * cos_view_zenith;\n", two);
-    o << fmt::format("    float tau_r = {0}, tau_g = {0}, tau_b = {0}, t_prev = {0};\n", zero);
+    // The view's depth: a trapezoid sum from the previous point, or (a family) Chapman integrals from the observer.
+    if (m.family)
+        o << fmt::format("    float tau_r = {0}, tau_g = {0}, tau_b = {0};\n", zero);
+    else
+        o << fmt::format("    float tau_r = {0}, tau_g = {0}, tau_b = {0}, t_prev = {0};\n", zero);
     for (int e = 0; e < m.ext_count; ++e)
-        o << fmt::format("    float prev{} = {}(-a_h / {});\n", e, exp_, H[std::size_t(e)]);
+        o << fmt::format("    float {0}{1} = {2}(-a_h / {3});\n", m.family ? "obs" : "prev", e, exp_, H[std::size_t(e)]);
     for (int k = 0; k < m.terms; ++k)
         o << fmt::format("    float A{0}r = {1}, A{0}g = {1}, A{0}b = {1};\n", k, zero);
     o << "    for (int part = 0; part < 2; ++part) {\n";
@@ -401,20 +415,29 @@ void emit_analytic_terms(std::ostringstream& o, const std::string& name, const M
     o << fmt::format("            float rp = {} + hp;\n", R0);
     o << "            float cos_chi = (a_r * cos_sun_zenith + t * cos_view_sun) / rp;\n";
     o << fmt::format("            float sun_r = {0}, sun_g = {0}, sun_b = {0};\n", zero);
+    if (m.family)
+        o << fmt::format("            tau_r = {0}; tau_g = {0}; tau_b = {0};\n", zero);
     for (int e = 0; e < m.ext_count; ++e) {
         o << fmt::format("            float dens{} = {}(-hp / {});\n", e, exp_, H[std::size_t(e)]);
         o << fmt::format("            sum{0} += dens{0} * dt;\n", e);
         o << "            {\n";
-        o << fmt::format("                float view = {0} * (dens{1} + prev{1}) * (t - t_prev);\n", half, e);
+        if (m.family)
+            o << fmt::format("                float view = {}_segment({}, {}, a_h, cos_view_zenith, obs{}, hp, "
+                             "(a_r * cos_view_zenith + t) / rp, dens{});\n",
+                             name, R0, H[std::size_t(e)], e, e);
+        else
+            o << fmt::format("                float view = {0} * (dens{1} + prev{1}) * (t - t_prev);\n", half, e);
         o << fmt::format("                float depth = {}_depth(hp, {}, {}, cos_chi, dens{});\n", name, R0,
                          H[std::size_t(e)], e);
         for (int c = 0; c < 3; ++c)
             o << fmt::format("                tau_{0} += {1} * view;\n                sun_{0} += {1} * depth;\n",
                              ch[c], be[std::size_t(3 * e + c)]);
         o << "            }\n";
-        o << fmt::format("            prev{0} = dens{0};\n", e);
+        if (!m.family)
+            o << fmt::format("            prev{0} = dens{0};\n", e);
     }
-    o << "            t_prev = t;\n";
+    if (!m.family)
+        o << "            t_prev = t;\n";
     for (int c = 0; c < 3; ++c) {
         o << "            {\n";
         o << fmt::format("                float tr = {0}(-(tau_{1} + sun_{1})) * dt;\n", exp_, ch[c]);
@@ -518,6 +541,9 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const S
     o << "// Inputs: cos_view_zenith = V.U, cos_view_sun = V.L, cos_sun_zenith = U.L (V: view direction,\n"
          "// U: local vertical at the observer, L: direction to the sun, all unit vectors) and density =\n"
          "// relative density of the first atmosphere component at the observer, in (0, 1].\n";
+    if (m.family && !ubo)
+        o << fmt::format("// aerosol: the amount of component \"{}\", a multiple of the atmosphere's, in [{:g}, {:g}].\n",
+                         net.encoding.family_component, net.encoding.aerosol_min, net.encoding.aerosol_max);
     o << fmt::format("// Output: {} radiance per unit sun irradiance (1/sr), linear RGB; multiply by the\n",
                      net.atmosphere.scattering == Scattering::Single ? "single-scattered" : "total (single + multiple)");
     if (ubo)
@@ -557,9 +583,10 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const S
                      lit(1.0f, d), lit(1.0f, d), d.exp2, lit(2.0f, d));
     if (m.output_kind == kOutputsResidual)
         o << residual_helpers(name, d, qual, hp);
+    // An aerosol family takes its amount as a fifth argument, or from the uniform block.
     const std::string params = fmt::format("{0}float cos_view_zenith, {0}float cos_view_sun, {0}float cos_sun_zenith, "
-                                           "{0}float density",
-                                           hp);
+                                           "{0}float density{1}",
+                                           hp, m.family && !ubo ? fmt::format(", {}float aerosol", hp) : "");
     if (d.shader)
         o << fmt::format("{}{} {}({}) {{\n", hp, d.vec3, name, params);
     else
@@ -576,6 +603,14 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const S
         emit_horizon_inputs(o, m, d, constant);
     else
         o << "    " << cst << "float in0 = cos_view_zenith, in1 = cos_view_sun, in2 = cos_sun_zenith, in3 = density;\n";
+    if (m.family) { // the last three values of the block (encoding_constants), or literals and the argument
+        const std::size_t at = n_weights + encoding_constants(net).size() - 3;
+        if (ubo)
+            o << fmt::format("    float aerosol = {};\n", uniform(at + 2));
+        o << fmt::format("    float in4 = {} * {}(aerosol) + {}; // the aerosol amount, -1 to 1 over its range\n",
+                         ubo ? uniform(at) : lit(m.family_a, d), d.shader ? "log" : "logf",
+                         ubo ? uniform(at + 1) : lit(m.family_b, d));
+    }
     std::vector<std::string> out_names{"R", "G", "B", "M"};
     if (m.output_kind != kOutputsRadiance) {
         out_names.clear();
@@ -592,6 +627,8 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const S
         o << (lay.subnets == 1 ? std::string("    // shared network\n")
                                : fmt::format("    // sub-network {}\n", out_names[std::size_t(s)]));
         std::vector<std::string> prev{"in0", "in1", "in2", "in3"};
+        if (m.family)
+            prev.push_back("in4");
         for (std::size_t l = 0; l < lay.layers.size(); ++l) {
             const LayerLayout& L = lay.layers[l];
             std::vector<std::string> cur;

@@ -80,28 +80,47 @@ std::vector<std::pair<std::string, NeuralSky>> export_cases() {
             cases.emplace_back(fmt::format("{} {}", top, e.name),
                                neural_test::with_encoding(make_net(top, BrightnessEncoding::Log), e.inputs, e.outputs, 7,
                                                           e.multiple));
+        // An aerosol family: a fifth argument, and the march's aerosol scaled by it.
+        cases.emplace_back(
+            fmt::format("{} horizon/residual, aerosol family at 3.7", top),
+            neural_test::with_family(neural_test::with_encoding(make_net(top, BrightnessEncoding::Log),
+                                                                InputEncoding::Horizon, OutputEncoding::Residual, 7),
+                                     0.5, 16.0, 3.7, 9));
     }
     return cases;
 }
 
+// Reads samples, writes the export's RGB; ARGS is how the function is called.
 const char* kDriver = R"(
 #include <stdio.h>
 int main(void) {
     float a, b, c, d, rgb[3];
     while (scanf("%f %f %f %f", &a, &b, &c, &d) == 4) {
-        skybake_sky(a, b, c, d, rgb);
+        skybake_sky(ARGS, rgb);
         printf("%.9g %.9g %.9g\n", rgb[0], rgb[1], rgb[2]);
     }
     return 0;
 }
 )";
 
+// The arguments of a call: an aerosol family's amount after the four.
+std::string args(const NeuralSky& net, const std::string& four) {
+    return net.encoding.has_family() ? fmt::format("{}, {:.9g}", four, net.aerosol) : four;
+}
+
+std::string driver(const NeuralSky& net) {
+    std::string d = kDriver;
+    const std::string args = net.encoding.has_family() ? fmt::format("a, b, c, d, {:.9g}f", net.aerosol) : "a, b, c, d";
+    d.replace(d.find("ARGS"), 4, args);
+    return d;
+}
+
 // Compiles the export with the system compiler and runs it on the samples.
 std::vector<glm::vec3> run_exported(const NeuralSky& net, ExportLanguage lang, const std::vector<SkySample>& s,
                                     const fs::path& dir) {
     const bool c = lang == ExportLanguage::C;
     const fs::path src = dir / (c ? "sky.c" : "sky.cpp"), exe = dir / "sky", in = dir / "in.txt", out = dir / "out.txt";
-    write(src, export_neural_sky(net, lang) + kDriver);
+    write(src, export_neural_sky(net, lang) + driver(net));
     std::ostringstream samples;
     for (const SkySample& x : s)
         samples << fmt::format("{:.9g} {:.9g} {:.9g} {:.9g}\n", x.cos_view_zenith, x.cos_view_sun, x.cos_sun_zenith,
@@ -144,6 +163,10 @@ TEST(NeuralExport, CAndCudaAgreeWithTheLibrary) {
                 for (std::size_t i = 0; i < s.size(); ++i) {
                     const glm::vec3 scalar = neural_sky_radiance(net, s[i]);
                     lit += glm::length(scalar) > 0.0f;
+                    if (relative(got[i], scalar) > 1e-3 && std::getenv("SKYBAKE_TEST_VERBOSE"))
+                        std::printf("sample %zu (%.9g %.9g %.9g %.9g): scalar %g %g %g, export %g %g %g\n", i,
+                                    s[i].cos_view_zenith, s[i].cos_view_sun, s[i].cos_sun_zenith, s[i].density,
+                                    scalar.x, scalar.y, scalar.z, got[i].x, got[i].y, got[i].z);
                     worst_scalar = std::max(worst_scalar, relative(got[i], scalar));
                     worst_batch = std::max(worst_batch, relative(got[i], batch[i]));
                 }
@@ -172,23 +195,30 @@ TEST(NeuralExport, GlslCompilesInVertexAndFragmentShaders) {
     for (const Encoding& e : kNewEncodings)
         nets.emplace_back(e.name, neural_test::with_encoding(make_net("paper", BrightnessEncoding::Log), e.inputs,
                                                              e.outputs, 3, e.multiple));
+    nets.emplace_back("aerosol family",
+                      neural_test::with_family(neural_test::with_encoding(make_net("paper", BrightnessEncoding::Log),
+                                                                          InputEncoding::Horizon,
+                                                                          OutputEncoding::Residual, 3),
+                                               1.0, 32.0, 2.5, 4));
     for (const auto& [top, net] : nets) {
         const std::string fn = export_neural_sky(net, ExportLanguage::Glsl);
+        const std::string attr = args(net, "attr.x, attr.y, attr.z, attr.w");
+        const std::string dirs = args(net, "dirs.x, dirs.y, dirs.z, dirs.w");
         write(dir / "sky.vert", "#version 330 core\n" + fn +
                                     "layout(location = 0) in vec4 attr;\nout vec3 colour;\n"
-                                    "void main() {\n    colour = skybake_sky(attr.x, attr.y, attr.z, attr.w);\n"
+                                    "void main() {\n    colour = skybake_sky(" + attr + ");\n"
                                     "    gl_Position = vec4(attr.xyz, 1.0);\n}\n");
         write(dir / "sky.frag", "#version 300 es\nprecision highp float;\n" + fn +
                                     "in vec4 dirs;\nout vec4 frag;\n"
-                                    "void main() { frag = vec4(skybake_sky(dirs.x, dirs.y, dirs.z, dirs.w), 1.0); }\n");
+                                    "void main() { frag = vec4(skybake_sky(" + dirs + "), 1.0); }\n");
         // GLSL ES 3.00 (WebGL 2) under a mediump default, in both stages.
         const std::string es = export_neural_sky(net, ExportLanguage::GlslEs);
         write(dir / "sky_es.frag", "#version 300 es\nprecision mediump float;\n" + es +
                                        "in vec4 dirs;\nout vec4 frag;\n"
-                                       "void main() { frag = vec4(skybake_sky(dirs.x, dirs.y, dirs.z, dirs.w), 1.0); }\n");
+                                       "void main() { frag = vec4(skybake_sky(" + dirs + "), 1.0); }\n");
         write(dir / "sky_es.vert", "#version 300 es\n" + es +
                                        "in vec4 attr;\nout vec3 colour;\n"
-                                       "void main() {\n    colour = skybake_sky(attr.x, attr.y, attr.z, attr.w);\n"
+                                       "void main() {\n    colour = skybake_sky(" + attr + ");\n"
                                        "    gl_Position = vec4(attr.xyz, 1.0);\n}\n");
         for (const char* stage : {"sky.vert", "sky.frag", "sky_es.vert", "sky_es.frag"}) {
             const std::string cmd = fmt::format("glslangValidator {} > {} 2>&1", (dir / stage).string(),
@@ -207,8 +237,9 @@ TEST(NeuralExport, HlslCompiles) {
     const fs::path dir = scratch("hlsl");
     for (const auto& [name, net] : export_cases()) {
         const std::string fn = export_neural_sky(net, ExportLanguage::Hlsl);
-        write(dir / "sky.hlsl", fn + "float4 main(float4 d : TEXCOORD0) : SV_Target {\n"
-                                     "    return float4(skybake_sky(d.x, d.y, d.z, d.w), 1.0f);\n}\n");
+        write(dir / "sky.hlsl", fn + "float4 main(float4 d : TEXCOORD0) : SV_Target {\n" +
+                                    fmt::format("    return float4(skybake_sky({}), 1.0f);\n}}\n",
+                                                args(net, "d.x, d.y, d.z, d.w")));
         const std::string cmd = fmt::format("glslangValidator -D -V -e main -S frag -o {} {} > {} 2>&1",
                                             (dir / "sky.spv").string(), (dir / "sky.hlsl").string(),
                                             (dir / "log.txt").string());

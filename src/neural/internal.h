@@ -38,6 +38,10 @@ void set_encoding_hd(const NeuralEncoding& encoding, const Atmosphere& atmospher
 // every term's component among them.
 void check_residual_atmosphere(const NeuralEncoding& encoding, const Atmosphere& atmosphere,
                                const std::string& where);
+// Throws skybake::Error (naming `where`: encoding.family) unless the
+// encoding's aerosol family is one the network can carry: residual outputs of
+// single scattering, a scattering component of the atmosphere, a valid range.
+void check_family(const NeuralEncoding& encoding, const Atmosphere& atmosphere, const std::string& where);
 // Indices of the atmosphere's components that scatter (a phase function and
 // some scattering): the phase-factored terms, in order.
 std::vector<int> phase_term_components(const Atmosphere& atmosphere);
@@ -93,6 +97,7 @@ struct TrainingData {
     MatF x, t, mask;
     MatF base; // residual outputs: analytic_terms per sample (3 per term), else empty
     std::vector<glm::vec3> radiance;
+    std::vector<float> aerosol; // an aerosol family: each sample's amount, else empty
     double mask_count = 0.0;
     std::size_t size() const { return radiance.size(); }
 };
@@ -109,6 +114,10 @@ constexpr double kTableRidge = 1e-6, kTableSmoothing = 1e-3;
 // (and max S per phase term) over options.max_n_samples samples. Throws
 // skybake::Error naming the option for combinations that cannot work.
 NeuralEncoding make_training_encoding(const SkyModel& model, const NeuralTrainOptions& options);
+// An aerosol family's amounts for n samples of `seed`: log-uniform over the range.
+std::vector<float> draw_aerosol(const NeuralEncoding& encoding, std::size_t n, std::uint64_t seed);
+// The atmosphere's index of the family's component (−1: none).
+int family_component_index(const NeuralEncoding& encoding, const Atmosphere& atmosphere);
 // n samples (seed) of model's table path with their encoded targets.
 TrainingData make_training_data(const SkyModel& model, const NeuralEncoding& encoding, std::size_t n,
                                 std::uint64_t seed, Device device);
@@ -122,14 +131,30 @@ NeuralSky train_network(NeuralSky net, const TrainingData& train, const Training
 
 // The held-out errors and view PSNRs of measure_neural_sky_error for any
 // approximation of `model`'s table path: a batch evaluator and a renderer.
-using BatchSky = std::function<void(std::span<const SkySample>, std::span<glm::vec3>)>;
-using RenderSky = std::function<Image(const SkyRenderSettings&)>;
+// With an aerosol family (`family` not null), each sample gets an amount
+// (draw_aerosol), the reference is the table path with the family's
+// component scaled by it, and the views are rendered at the range's ends and
+// its geometric middle; the evaluator and renderer receive the amounts (empty
+// and 1 without a family).
+using BatchSky = std::function<void(std::span<const SkySample>, std::span<const float> aerosol, std::span<glm::vec3>)>;
+using RenderSky = std::function<Image(const SkyRenderSettings&, double aerosol)>;
 NeuralErrorReport measure_approximation_error(const SkyModel& model, double max_n, const NeuralErrorOptions& options,
-                                              const BatchSky& evaluate, const RenderSky& render);
+                                              const BatchSky& evaluate, const RenderSky& render,
+                                              const NeuralEncoding* family = nullptr);
+// The table path of `model` with component `component` scaled by each
+// sample's amount (an aerosol family's reference): Σ_k P_k S_k of the split sums.
+void scaled_sky_targets(const SkyModel& model, std::span<const SkySample> samples, std::span<const float> aerosol,
+                        int component, std::vector<glm::vec3>& split, std::vector<glm::vec3>& radiance);
+// The atmosphere with the family's component scaled by `aerosol`.
+Atmosphere scaled_atmosphere(const NeuralEncoding& family, const Atmosphere& atmosphere, double aerosol);
 
-// Network inputs (4 × n) from samples, through the input encoding of m.
-MatF samples_to_matrix(const MlpHD& m, std::span<const SkySample> samples);
+// Network inputs (m.width[0] × n) from samples, through the input encoding of
+// m; `aerosol`, when not empty, holds each sample's aerosol amount (a family).
+MatF samples_to_matrix(const MlpHD& m, std::span<const SkySample> samples, std::span<const float> aerosol = {});
 // analytic_terms (3 per term × n) of the samples.
-MatF analytic_matrix(const MlpHD& m, std::span<const SkySample> samples);
+MatF analytic_matrix(const MlpHD& m, std::span<const SkySample> samples, std::span<const float> aerosol = {});
+// evaluate_neural_sky with each sample's own aerosol amount (empty: net.aerosol).
+void evaluate_neural_sky_at(const NeuralSky& net, std::span<const SkySample> samples, std::span<const float> aerosol,
+                            std::span<glm::vec3> out);
 
 } // namespace skybake::neural

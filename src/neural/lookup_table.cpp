@@ -63,7 +63,7 @@ Corners corners(const SkyLookupTable& t, const float in[4]) {
 
 // The table's radiance for one sample of the sky function.
 glm::vec3 table_sky(const SkyLookupTable& t, const MlpHD& m, float cv, float cvs, float cs, float rho) {
-    float in[kInputs], enc[kMaxOutputs] = {};
+    float in[kMaxInputs], enc[kMaxOutputs] = {};
     encode_inputs(m, cv, cvs, cs, rho, in);
     const Corners k = corners(t, in);
     const std::size_t outputs = std::size_t(m.outputs);
@@ -230,8 +230,10 @@ NeuralErrorReport measure_sky_lookup_table_error(const SkyLookupTable& t, const 
     auto sky = [&](float cv, float cvs, float cs, float rho) { return table_sky(t, m, cv, cvs, cs, rho); };
     return measure_approximation_error(
         model, t.encoding.max_n, o,
-        [&](std::span<const SkySample> s, std::span<glm::vec3> out) { evaluate_sky_lookup_table(t, s, out); },
-        [&](const SkyRenderSettings& v) {
+        [&](std::span<const SkySample> s, std::span<const float>, std::span<glm::vec3> out) {
+            evaluate_sky_lookup_table(t, s, out);
+        },
+        [&](const SkyRenderSettings& v, double) {
             const sky::RenderHD p = sky::make_render_hd(model, v);
             return sky::render_pixels(p, [&](const glm::vec3& d) { return shade_ray_approximate(p, sky, d); });
         });

@@ -41,7 +41,7 @@ Layout make_layout(const NeuralTopology& topology) {
     Layout lay;
     lay.subnets = topology.subnet_count();
     lay.outputs = topology.outputs_per_subnet();
-    std::vector<int> widths{kInputs};
+    std::vector<int> widths{topology.inputs};
     widths.insert(widths.end(), topology.hidden.begin(), topology.hidden.end());
     widths.push_back(lay.outputs);
     int off = 0;
@@ -66,12 +66,13 @@ MlpHD make_mlp_hd(const NeuralSky& net) {
     m.weights = net.weights.data();
     m.subnets = lay.subnets;
     m.layers = int(lay.layers.size());
-    m.width[0] = kInputs;
+    m.width[0] = net.topology.inputs;
     for (int l = 0; l < m.layers; ++l)
         m.width[l + 1] = lay.layers[std::size_t(l)].out;
     m.subnet_params = lay.subnet_params;
     m.outputs = net.topology.outputs;
     set_encoding_hd(net.encoding, net.atmosphere, m);
+    m.aerosol = float(net.aerosol);
     return m;
 }
 
@@ -114,6 +115,35 @@ void set_encoding_hd(const NeuralEncoding& e, const Atmosphere& atmosphere, MlpH
                 }
             ++m.ext_count;
         }
+    if (!e.has_family())
+        return;
+    m.family = 1;
+    for (int k = 0; k < m.terms; ++k)
+        if (e.terms[std::size_t(k)].component == e.family_component) {
+            m.family_term = k;
+            m.family_ext = m.term_ext[k];
+        }
+    // in4 = a ln(aerosol) + b: −1 at aerosol_min, +1 at aerosol_max.
+    const double lo = std::log(e.aerosol_min), hi = std::log(e.aerosol_max);
+    m.family_a = float(2.0 / (hi - lo));
+    m.family_b = float(-(hi + lo) / (hi - lo));
+}
+
+void check_family(const NeuralEncoding& e, const Atmosphere& atmosphere, const std::string& where) {
+    const std::string& fw = where;
+    if (e.outputs != OutputEncoding::Residual || e.multiple)
+        throw Error("an aerosol family needs residual outputs of single scattering (its analytic march scales the "
+                    "aerosol); multiple scattering is not supported in a family",
+                    fw);
+    if (std::none_of(e.terms.begin(), e.terms.end(), [&](const PhaseTerm& t) { return t.component == e.family_component; }))
+        throw Error(fmt::format("the family's component '{}' is not a scattering component of atmosphere '{}'",
+                                e.family_component, atmosphere.name),
+                    fw);
+    if (!(std::isfinite(e.aerosol_min) && std::isfinite(e.aerosol_max) && e.aerosol_min > 0.0 &&
+          e.aerosol_max > e.aerosol_min * 1.001 && e.aerosol_max <= e.aerosol_min * 1e4))
+        throw Error(fmt::format("the aerosol range [{}, {}] must be positive, increasing and span at most 1e4",
+                                e.aerosol_min, e.aerosol_max),
+                    fw);
 }
 
 void check_residual_atmosphere(const NeuralEncoding& e, const Atmosphere& atmosphere, const std::string& where) {
@@ -305,13 +335,16 @@ void encode_residual_targets(std::span<const glm::vec3> split, std::size_t compo
     });
 }
 
-MatF analytic_matrix(const MlpHD& m, std::span<const SkySample> samples) {
+MatF analytic_matrix(const MlpHD& m, std::span<const SkySample> samples, std::span<const float> aerosol) {
     MatF a(3 * m.terms, Eigen::Index(samples.size()));
     parallel_for(samples.size(), 4096, [&](std::size_t b, std::size_t e) {
         float base[kMaxOutputs];
+        MlpHD at = m;
         for (std::size_t i = b; i < e; ++i) {
             const SkySample& s = samples[i];
-            analytic_terms(m, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, base);
+            if (!aerosol.empty())
+                at.aerosol = aerosol[i];
+            analytic_terms(at, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, base);
             for (int k = 0; k < 3 * m.terms; ++k)
                 a(k, Eigen::Index(i)) = base[k];
         }
@@ -326,11 +359,17 @@ float encode_log(double value, double max, double log_range) {
     return float(kEncodeOffset + kEncodeScale * std::min(m, 1.0));
 }
 
-MatF samples_to_matrix(const MlpHD& m, std::span<const SkySample> samples) {
-    MatF x(4, Eigen::Index(samples.size()));
+MatF samples_to_matrix(const MlpHD& m, std::span<const SkySample> samples, std::span<const float> aerosol) {
+    MatF x(m.width[0], Eigen::Index(samples.size()));
+    MlpHD at = m;
     for (std::size_t i = 0; i < samples.size(); ++i) {
         const SkySample& s = samples[i];
-        encode_inputs(m, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, x.col(Eigen::Index(i)).data());
+        if (!aerosol.empty())
+            at.aerosol = aerosol[i];
+        float in[kMaxInputs];
+        encode_inputs(at, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, in);
+        for (int k = 0; k < m.width[0]; ++k)
+            x(k, Eigen::Index(i)) = in[k];
     }
     return x;
 }
@@ -361,23 +400,33 @@ glm::vec3 decode_sky_radiance(const NeuralEncoding& e, const float enc[4]) {
 }
 
 void evaluate_neural_sky(const NeuralSky& net, std::span<const SkySample> samples, std::span<glm::vec3> out) {
+    evaluate_neural_sky_at(net, samples, {}, out);
+}
+
+void neural::evaluate_neural_sky_at(const NeuralSky& net, std::span<const SkySample> samples,
+                                    std::span<const float> aerosol, std::span<glm::vec3> out) {
     assert(samples.size() == out.size());
+    assert(aerosol.empty() || aerosol.size() == samples.size());
     assert(net.weights.size() == std::size_t(net.topology.weight_count()));
     const Layout layout = make_layout(net.topology);
-    const MlpHD hd = make_mlp_hd(net);
+    const MlpHD hd0 = make_mlp_hd(net);
     constexpr std::size_t kBlock = 1024;
     const std::size_t blocks = (samples.size() + kBlock - 1) / kBlock;
     parallel_for(blocks, 1, [&](std::size_t b0, std::size_t b1) {
         Workspace ws;
-        MatF enc(hd.outputs, Eigen::Index(kBlock));
+        MatF enc(hd0.outputs, Eigen::Index(kBlock));
         for (std::size_t b = b0; b < b1; ++b) {
             const std::size_t lo = b * kBlock, hi = std::min(samples.size(), lo + kBlock);
-            const MatF x = samples_to_matrix(hd, samples.subspan(lo, hi - lo));
-            enc.resize(hd.outputs, x.cols());
+            const MatF x = samples_to_matrix(hd0, samples.subspan(lo, hi - lo),
+                                             aerosol.empty() ? aerosol : aerosol.subspan(lo, hi - lo));
+            enc.resize(hd0.outputs, x.cols());
             forward_network(layout, net.weights.data(), x, enc, ws);
             float base[kMaxOutputs];
+            MlpHD hd = hd0;
             for (std::size_t i = lo; i < hi; ++i) {
                 const SkySample& s = samples[i];
+                if (!aerosol.empty())
+                    hd.aerosol = aerosol[i];
                 assert(is_valid_sky_sample(s, 1e-4));
                 if (hd.output_kind == kOutputsResidual)
                     analytic_terms(hd, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, base);
@@ -394,7 +443,7 @@ glm::vec3 neural_sky_radiance(const NeuralSky& net, const SkySample& s) {
 
 void neural_sky_encoded(const NeuralSky& net, const SkySample& s, float* enc) {
     const MlpHD hd = make_mlp_hd(net);
-    float in[kInputs];
+    float in[kMaxInputs];
     encode_inputs(hd, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, in);
     mlp_forward(hd, in, enc);
 }

@@ -21,7 +21,8 @@
 
 namespace skybake::neural {
 
-constexpr int kInputs = 4;
+constexpr int kInputs = 4;      // the sky function's arguments
+constexpr int kMaxInputs = 5;   // and an aerosol family's amount (MlpHD::family)
 constexpr int kOutputs = 4;     // the seed's outputs: R, G, B, M
 constexpr int kMaxTerms = 4;    // phase-factored: one RGB term per scattering component
 constexpr int kMaxOutputs = 3 * kMaxTerms + 3; // and residual outputs' multiple-scattering term
@@ -76,6 +77,15 @@ struct MlpHD {
     // and with multiple scattering, the log-encoded term after the others.
     int multiple = 0;
     float multiple_max[3] = {};
+    // An aerosol family (residual outputs): the network's fifth input is
+    // family_a ln(aerosol) + family_b (−1 to 1 over the trained range), and the
+    // march scales the extinction of exponential component family_ext and the
+    // scattering of term family_term by aerosol, a multiple of the
+    // atmosphere's amount chosen at run time.
+    int family = 0;
+    int family_ext = 0, family_term = 0;
+    float family_a = 0.0f, family_b = 0.0f;
+    float aerosol = 1.0f;
 };
 
 SKYBAKE_HD_INLINE float seed_activation(float x) { return 1.0f / (1.0f + exp2f(2.0f * x)); }
@@ -100,8 +110,8 @@ SKYBAKE_HD_INLINE void mlp_subnet_forward(const MlpHD& m, const float* w, const 
     }
 }
 
-// The network's encoded outputs (m.outputs of them) for its 4 inputs.
-SKYBAKE_HD_INLINE void mlp_forward(const MlpHD& m, const float in[kInputs], float* enc) {
+// The network's encoded outputs (m.outputs of them) for its width[0] inputs.
+SKYBAKE_HD_INLINE void mlp_forward(const MlpHD& m, const float in[kMaxInputs], float* enc) {
     if (m.subnets == 1) {
         mlp_subnet_forward(m, m.weights, in, enc);
         return;
@@ -169,10 +179,13 @@ SKYBAKE_HD_INLINE float log_density(float x) {
 //        (asin cos θ0 + atan(ρ/R0)) / (π/2), was tried and measured worse:
 //        docs/neural.md.)
 //   in3: 2 ρ/Ĥ − 1 (Bruneton's r coordinate: fine near the ground).
+// An aerosol family adds in4 = family_a ln(aerosol) + family_b.
 SKYBAKE_HD_INLINE void encode_inputs(const MlpHD& m, float cos_view_zenith, float cos_view_sun, float cos_sun_zenith,
-                                     float density, float in[kInputs]) {
+                                     float density, float in[kMaxInputs]) {
     in[1] = cos_view_sun;
     in[2] = cos_sun_zenith;
+    if (m.family)
+        in[4] = m.family_a * logf(m.aerosol) + m.family_b;
     if (m.inputs != kInputsHorizon) {
         in[0] = cos_view_zenith;
         in[3] = density;
@@ -205,7 +218,11 @@ SKYBAKE_HD_INLINE void encode_inputs(const MlpHD& m, float cos_view_zenith, floa
 //  - the march covers only the ray's lit parts: the planet's shadow of a
 //    parallel sun is one interval of the ray (shadow_span), so up to two lit
 //    parts of kResidualSteps midpoint steps each;
-//  - the view's optical depth is a trapezoid sum over the same points.
+//  - the view's optical depth is a trapezoid sum over the same points; for
+//    an aerosol family, whose hazy members put optical depths of tens on a
+//    grazing ray that four trapezoids miss by factors of e^7, the
+//    difference of Chapman integrals from the observer to each point
+//    (chapman_segment) instead.
 // Only the exponential components take part (ozone-like tents and constant
 // shells are left to the network). The network's output x per term and
 // channel is S = A exp(R (x − 0.5)/0.45), R = kResidualRange.
@@ -313,12 +330,20 @@ SKYBAKE_HD_INLINE void analytic_terms(const MlpHD& m, float cos_view_zenith, flo
             v.d = k / (rc + sqrtf(disc > 0.0f ? disc : 0.0f));
         }
     }
+    // The family's aerosol amount scales its component's coefficients.
+    float ext_beta[kMaxTerms][3], term_beta[kMaxTerms][3];
+    for (int e = 0; e < m.ext_count; ++e)
+        for (int c = 0; c < 3; ++c)
+            ext_beta[e][c] = m.family && e == m.family_ext ? m.ext_beta[e][c] * m.aerosol : m.ext_beta[e][c];
+    for (int k = 0; k < m.terms; ++k)
+        for (int c = 0; c < 3; ++c)
+            term_beta[k][c] = m.family && k == m.family_term ? m.term_beta[k][c] * m.aerosol : m.term_beta[k][c];
     float lo, hi;
     const bool shadow = shadow_span(v.r, v.rho, cos_view_zenith, cos_view_sun, cos_sun_zenith, v.d, lo, hi);
     const float rho2 = v.rho * v.rho, two_r_mu = 2.0f * v.r * cos_view_zenith;
-    float prev[kMaxTerms], tau[3] = {0.0f, 0.0f, 0.0f}, t_prev = 0.0f;
+    float prev[kMaxTerms], obs[kMaxTerms], tau[3] = {0.0f, 0.0f, 0.0f}, t_prev = 0.0f;
     for (int e = 0; e < m.ext_count; ++e)
-        prev[e] = expf(-v.h / m.ext_height[e]);
+        prev[e] = obs[e] = expf(-v.h / m.ext_height[e]);
     for (int part = 0; part < 2; ++part) {
         const float a = part == 0 ? 0.0f : (shadow ? hi : v.d);
         const float b = part == 0 ? (shadow ? lo : v.d) : v.d;
@@ -350,14 +375,18 @@ SKYBAKE_HD_INLINE void analytic_terms(const MlpHD& m, float cos_view_zenith, flo
             const float rp = m.R0 + hp;
             const float cos_chi = (v.r * cos_sun_zenith + t * cos_view_sun) / rp;
             float dens[kMaxTerms], sun[3] = {0.0f, 0.0f, 0.0f};
+            if (m.family) // the view's depth from the observer, as Chapman integrals (see below)
+                tau[0] = tau[1] = tau[2] = 0.0f;
             for (int e = 0; e < m.ext_count; ++e) {
                 dens[e] = expf(-hp / m.ext_height[e]);
                 sum_rho[e] += dens[e] * dt;
-                const float view = 0.5f * (dens[e] + prev[e]) * (t - t_prev);
+                const float view = m.family ? chapman_segment(m.R0, m.ext_height[e], v.h, cos_view_zenith, obs[e], hp,
+                                                              (v.r * cos_view_zenith + t) / rp, dens[e])
+                                            : 0.5f * (dens[e] + prev[e]) * (t - t_prev);
                 const float depth = chapman_depth(hp, m.R0, m.ext_height[e], cos_chi, dens[e]);
                 for (int c = 0; c < 3; ++c) {
-                    tau[c] += m.ext_beta[e][c] * view;
-                    sun[c] += m.ext_beta[e][c] * depth;
+                    tau[c] += ext_beta[e][c] * view;
+                    sun[c] += ext_beta[e][c] * depth;
                 }
                 prev[e] = dens[e];
             }
@@ -365,7 +394,7 @@ SKYBAKE_HD_INLINE void analytic_terms(const MlpHD& m, float cos_view_zenith, flo
             for (int c = 0; c < 3; ++c) {
                 const float tr = expf(-(tau[c] + sun[c])) * dt;
                 for (int k2 = 0; k2 < m.terms; ++k2)
-                    part_sum[3 * k2 + c] += m.term_beta[k2][c] * dens[m.term_ext[k2]] * tr;
+                    part_sum[3 * k2 + c] += term_beta[k2][c] * dens[m.term_ext[k2]] * tr;
             }
         }
         for (int k2 = 0; k2 < m.terms; ++k2) {
@@ -445,7 +474,7 @@ SKYBAKE_HD_INLINE glm::vec3 decode_sky(const MlpHD& m, const float* enc, float c
 
 SKYBAKE_HD_INLINE glm::vec3 neural_sky(const MlpHD& m, float cos_view_zenith, float cos_view_sun,
                                        float cos_sun_zenith, float density) {
-    float in[kInputs];
+    float in[kMaxInputs];
     encode_inputs(m, cos_view_zenith, cos_view_sun, cos_sun_zenith, density, in);
     float enc[kMaxOutputs];
     mlp_forward(m, in, enc);

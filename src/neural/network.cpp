@@ -28,7 +28,7 @@ constexpr int kVersion = 3;
 } // namespace
 
 int NeuralTopology::subnet_weight_count() const {
-    int in = neural::kInputs, n = 0;
+    int in = inputs, n = 0;
     for (int w : hidden) {
         n += (in + 1) * w;
         in = w;
@@ -54,6 +54,9 @@ void NeuralTopology::validate(const std::string& where) const {
             throw Error(fmt::format("hidden layer width {} is outside 1..{}", w, neural::kMaxWidth), where);
     if (outputs < 1 || outputs > neural::kMaxOutputs)
         throw Error(fmt::format("a network has 1 to {} outputs, not {}", neural::kMaxOutputs, outputs), where);
+    if (inputs < neural::kInputs || inputs > neural::kMaxInputs)
+        throw Error(fmt::format("a network has {} or {} inputs, not {}", neural::kInputs, neural::kMaxInputs, inputs),
+                    where);
 }
 
 NeuralTopology parse_topology(std::string_view text, const std::string& where) {
@@ -130,6 +133,21 @@ void NeuralSky::validate(const std::string& where) const {
     }
     if (encoding.outputs == OutputEncoding::Residual)
         neural::check_residual_atmosphere(encoding, atmosphere, where);
+    if (encoding.has_family())
+        neural::check_family(encoding, atmosphere, where + ": encoding.family");
+    if (topology.inputs != encoding.input_count())
+        throw Error(fmt::format("topology.inputs is {} but the encoding has {} inputs", topology.inputs,
+                                encoding.input_count()),
+                    where);
+    const double lo = encoding.has_family() ? encoding.aerosol_min : 1.0;
+    const double hi = encoding.has_family() ? encoding.aerosol_max : 1.0;
+    if (!(aerosol >= lo * (1.0 - 1e-9) && aerosol <= hi * (1.0 + 1e-9)))
+        throw Error(encoding.has_family()
+                        ? fmt::format("the aerosol amount {} is outside the family's range [{}, {}]", aerosol, lo, hi)
+                        : fmt::format("the aerosol amount {} needs a network of an aerosol family (sky train "
+                                      "--aerosol-range); this one knows only its atmosphere's (1)",
+                                      aerosol),
+                    where + ": aerosol");
     if (topology.outputs != encoding.output_count())
         throw Error(fmt::format("topology.outputs is {} but the {} encoding has {} outputs", topology.outputs,
                                 output_encoding_name(encoding.outputs), encoding.output_count()),
@@ -146,10 +164,11 @@ std::string neural_sky_to_json(const NeuralSky& net) {
                      {"kind", net.topology.shared ? "shared" : "independent"},
                      {"hidden", net.topology.hidden},
                      {"outputs", net.topology.outputs},
-                     {"input_meaning", e.inputs == InputEncoding::Seed
-                                           ? "cos_view_zenith, cos_view_sun, cos_sun_zenith, density"
-                                           : "view ray length split at the horizon, cos_view_sun, cos_sun_zenith, "
-                                             "altitude coordinate"},
+                     {"input_meaning", std::string(e.inputs == InputEncoding::Seed
+                                                       ? "cos_view_zenith, cos_view_sun, cos_sun_zenith, density"
+                                                       : "view ray length split at the horizon, cos_view_sun, "
+                                                         "cos_sun_zenith, altitude coordinate") +
+                                           (e.has_family() ? ", aerosol amount (log, -1 to 1 over its range)" : "")},
                      {"output_meaning",
                       e.outputs == OutputEncoding::Residual
                           ? "per term, ln(S/A) for r, g, b (A: the analytic march; each as 0.5 + 0.45 value/2)"
@@ -173,6 +192,11 @@ std::string neural_sky_to_json(const NeuralSky& net) {
     }
     if (e.multiple)
         j["encoding"]["multiple_max"] = {e.multiple_max.x, e.multiple_max.y, e.multiple_max.z};
+    if (e.has_family()) {
+        j["topology"]["inputs"] = net.topology.inputs;
+        j["encoding"]["family"] = {{"component", e.family_component},
+                                   {"aerosol_range", {e.aerosol_min, e.aerosol_max}}};
+    }
     json subnets = json::array();
     const std::size_t per = std::size_t(net.topology.subnet_weight_count());
     for (int s = 0; s < net.topology.subnet_count(); ++s) {
@@ -306,6 +330,19 @@ NeuralSky neural_sky_from_json(std::string_view text, const std::string& where) 
                 net.encoding.multiple = true;
                 net.encoding.multiple_max = glm::dvec3(mm[0].get<double>(), mm[1].get<double>(), mm[2].get<double>());
             }
+            if (enc.contains("family")) {
+                const std::string fw = where + ": encoding.family";
+                const json& f = enc["family"];
+                const json& c = field(f, "component", fw);
+                const json& r = field(f, "aerosol_range", fw);
+                if (!c.is_string() || c.get<std::string>().empty() || !r.is_array() || r.size() != 2 ||
+                    !r[0].is_number() || !r[1].is_number())
+                    throw Error("encoding.family needs a component name and aerosol_range [min, max]", fw);
+                net.encoding.family_component = c.get<std::string>();
+                net.encoding.aerosol_min = r[0].get<double>();
+                net.encoding.aerosol_max = r[1].get<double>();
+                net.topology.inputs = integer(top, "inputs", where + ": topology", neural::kInputs, neural::kMaxInputs);
+            }
             net.topology.outputs = integer(top, "outputs", where + ": topology", 1, neural::kMaxOutputs);
             if (net.topology.outputs != net.encoding.output_count())
                 throw Error(fmt::format("topology.outputs is {} but the encoding has {} outputs",
@@ -378,7 +415,11 @@ void save_neural_sky(const std::filesystem::path& path, const NeuralSky& net) {
     write_stream_atomic(path, [&](std::ostream& out) { out << text; });
 }
 
-SkyModel neural_reference_model(const NeuralSky& net) { return SkyModel(net.atmosphere, net.sky_options); }
+SkyModel neural_reference_model(const NeuralSky& net) {
+    if (net.encoding.has_family() && net.aerosol != 1.0)
+        return SkyModel(neural::scaled_atmosphere(net.encoding, net.atmosphere, net.aerosol), net.sky_options);
+    return SkyModel(net.atmosphere, net.sky_options);
+}
 
 namespace {
 constexpr NamedValue<BrightnessEncoding> kBrightnessNames[] = {

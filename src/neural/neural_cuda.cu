@@ -113,7 +113,7 @@ __global__ void neural_kernel(MlpHD m, const float* weights, const SkySample* sa
     if (i >= n)
         return;
     const SkySample s = samples[i];
-    float in[kInputs];
+    float in[kMaxInputs];
     encode_inputs(m, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, in);
     if (!Fixed && m.output_kind == kOutputsResidual)
         out[i] = residual_network(m, weights, in, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density);
@@ -126,7 +126,7 @@ __global__ void throughput_kernel(MlpHD m, const float* weights, std::uint64_t n
     float acc = 0.0f;
     const std::uint64_t stride = std::uint64_t(gridDim.x) * blockDim.x;
     for (std::uint64_t i = std::uint64_t(blockIdx.x) * blockDim.x + threadIdx.x; i < n; i += stride) {
-        float x[4], in[kInputs];
+        float x[4], in[kMaxInputs];
         throughput_inputs(std::uint32_t(i), x);
         encode_inputs(m, x[0], x[1], x[2], x[3], in);
         const glm::vec3 c = !Fixed && m.output_kind == kOutputsResidual

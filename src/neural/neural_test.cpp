@@ -546,7 +546,7 @@ TEST(NeuralEncoding, HorizonInputsPutTheHorizonsSidesFarApart) {
     for (double h : {0.1, 2.0, 30.0}) {
         const float rho = float(std::exp(-h / H));
         const double horizon = -std::sqrt(1.0 - (R0 / (R0 + h)) * (R0 / (R0 + h))); // cos of the horizon
-        float in[4];
+        float in[neural::kMaxInputs];
         encode_inputs(m, 1.0f, 0.3f, 0.5f, rho, in);
         EXPECT_NEAR(in[0], kHorizonGap, 1e-4) << h; // zenith: the shortest up ray
         EXPECT_FLOAT_EQ(in[1], 0.3f);
@@ -566,7 +566,7 @@ TEST(NeuralEncoding, HorizonInputsPutTheHorizonsSidesFarApart) {
     float last = -2.0f;
     const float rho = float(std::exp(-1.0 / H));
     for (int i = 0; i <= 200; ++i) {
-        float in[4];
+        float in[neural::kMaxInputs];
         const float cv = -0.0175f + 1.0175f * float(i) / 200.0f; // from just above the horizon (h = 1 km) up
         encode_inputs(m, cv, 0.0f, 0.5f, rho, in);
         if (i > 0)

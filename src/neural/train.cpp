@@ -49,10 +49,17 @@ void sky_targets(const SkyModel& model, std::span<const SkySample> s, std::span<
 // The phase-free parts S_k of the table path (n × components) and the radiance Σ_k P_k S_k they make.
 void split_targets(const SkyModel& model, std::span<const SkySample> s, std::vector<glm::vec3>& split,
                    std::vector<glm::vec3>& radiance) {
+    scaled_sky_targets(model, s, {}, -1, split, radiance);
+}
+
+} // namespace
+
+void neural::scaled_sky_targets(const SkyModel& model, std::span<const SkySample> s, std::span<const float> aerosol,
+                                int family, std::vector<glm::vec3>& split, std::vector<glm::vec3>& radiance) {
     const Atmosphere& atm = model.atmosphere();
     const std::size_t nc = atm.components.size();
     split.resize(s.size() * nc);
-    sky::evaluate_sky_split(model, s, split);
+    sky::evaluate_sky_split(model, s, split, aerosol, family);
     radiance.resize(s.size());
     for (std::size_t i = 0; i < s.size(); ++i) {
         glm::dvec3 c(0.0);
@@ -63,7 +70,33 @@ void split_targets(const SkyModel& model, std::span<const SkySample> s, std::vec
     }
 }
 
-} // namespace
+Atmosphere neural::scaled_atmosphere(const NeuralEncoding& family, const Atmosphere& atmosphere, double aerosol) {
+    Atmosphere a = atmosphere;
+    for (AtmosphereComponent& c : a.components)
+        if (c.name == family.family_component) {
+            // As evaluate_sky_split scales the float coefficients (×1 is exact).
+            c.scattering_per_km *= aerosol;
+            c.extinction_per_km *= aerosol;
+        }
+    return a;
+}
+
+std::vector<float> neural::draw_aerosol(const NeuralEncoding& enc, std::size_t n, std::uint64_t seed) {
+    // Log-uniform over [aerosol_min, aerosol_max], from its own stream of the samples' seed.
+    SplitMix rng{seed ^ 0xae505015ae505015ull};
+    const double lo = std::log(enc.aerosol_min), hi = std::log(enc.aerosol_max);
+    std::vector<float> a(n);
+    for (float& v : a)
+        v = float(std::exp(lo + (hi - lo) * rng.uniform()));
+    return a;
+}
+
+int neural::family_component_index(const NeuralEncoding& enc, const Atmosphere& atmosphere) {
+    for (std::size_t k = 0; k < atmosphere.components.size(); ++k)
+        if (atmosphere.components[k].name == enc.family_component)
+            return int(k);
+    return -1;
+}
 
 TrainingData neural::make_training_data(const SkyModel& model, const NeuralEncoding& enc, std::size_t n,
                                         std::uint64_t seed, Device device) {
@@ -71,11 +104,17 @@ TrainingData neural::make_training_data(const SkyModel& model, const NeuralEncod
     const std::vector<SkySample> s = draw_sky_samples(n, seed);
     MlpHD hd;
     set_encoding_hd(enc, model.atmosphere(), hd);
-    d.x = samples_to_matrix(hd, s);
+    hd.width[0] = enc.input_count();
+    int family = -1;
+    if (enc.has_family()) {
+        d.aerosol = draw_aerosol(enc, n, seed);
+        family = family_component_index(enc, model.atmosphere());
+    }
+    d.x = samples_to_matrix(hd, s, d.aerosol);
     if (enc.outputs == OutputEncoding::Residual) {
         std::vector<glm::vec3> split;
-        split_targets(model, s, split, d.radiance);
-        d.base = analytic_matrix(hd, s);
+        scaled_sky_targets(model, s, d.aerosol, family, split, d.radiance);
+        d.base = analytic_matrix(hd, s, d.aerosol);
         encode_residual_targets(split, model.atmosphere().components.size(),
                                 phase_term_components(model.atmosphere()), d.base, d.t, d.mask);
         if (enc.multiple) {
@@ -189,7 +228,7 @@ GradPart batch_gradient(const Layout& lay, const std::vector<float>& w, const Da
         [&](std::size_t b, std::size_t e) {
             GradPart part{0.0, std::vector<double>(P, 0.0)};
             const Eigen::Index n = Eigen::Index(e - b);
-            MatF x(4, n), t(d.t.rows(), n), m(d.t.rows(), n);
+            MatF x(d.x.rows(), n), t(d.t.rows(), n), m(d.t.rows(), n);
             for (Eigen::Index j = 0; j < n; ++j) {
                 const Eigen::Index c = Eigen::Index(idx[lo + b + std::size_t(j)]);
                 x.col(j) = d.x.col(c);
@@ -345,6 +384,12 @@ NeuralEncoding neural::make_training_encoding(const SkyModel& model, const Neura
     }
     if (o.outputs == OutputEncoding::Residual)
         check_residual_atmosphere(encoding, model.atmosphere(), "outputs");
+    if (!o.family_component.empty()) {
+        encoding.family_component = o.family_component;
+        encoding.aerosol_min = o.aerosol_min;
+        encoding.aerosol_max = o.aerosol_max;
+        check_family(encoding, model.atmosphere(), "family_component");
+    }
     return encoding;
 }
 
@@ -370,6 +415,7 @@ NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, s
     net.sky_options = model.options();
     net.encoding = make_training_encoding(model, o);
     net.topology.outputs = net.encoding.output_count();
+    net.topology.inputs = net.encoding.input_count();
     const DataSet train = make_training_data(model, net.encoding, o.samples, stream_seed(o.seed, 0), o.device);
     const DataSet held = make_training_data(model, net.encoding, o.heldout_samples, stream_seed(o.seed, 1), o.device);
     return train_network(std::move(net), train, held, o, curve, t0);

@@ -218,6 +218,21 @@ TEST(GlNetwork, EveryEncodingMatchesTheCppForwardPass) {
                     "inputs\n",
                     lang == ExportLanguage::Glsl ? "GLSL" : "GLSL ES", err, compared);
     }
+    // An aerosol family: its fifth input and the march's scaled aerosol, the
+    // amount read from the uniform block (the renderers' path).
+    for (ExportLanguage lang : {ExportLanguage::Glsl, ExportLanguage::GlslEs}) {
+        NeuralSky net = neural_test::with_family(encoded_network(InputEncoding::Horizon, OutputEncoding::Residual), 1.0,
+                                                 32.0, 6.5, 12);
+        for (float& w : net.weights)
+            w *= 0.5f;
+        int compared = 0;
+        const double err = glsl_network_error(net, &compared, lang);
+        EXPECT_GT(compared, 3000);
+        EXPECT_LT(err, 1e-5);
+        std::printf("%s network (residual outputs, aerosol family at 6.5) vs mlp_hd.h: max relative error %.3g over "
+                    "%d inputs\n",
+                    lang == ExportLanguage::Glsl ? "GLSL" : "GLSL ES", err, compared);
+    }
 }
 
 // The uniform-block source depends on the topology and the encoding only.

@@ -29,7 +29,11 @@ ObserverHD make_observer(const Atmosphere& atmosphere, const SkySample& sample);
 // The model's single-scattering table path split by component without the
 // phase functions (seed_sky_sum_split), over all cores:
 // out[i * components + k] for sample i and component k.
-void evaluate_sky_split(const SkyModel& model, std::span<const SkySample> samples, std::span<glm::vec3> out);
+// With `scale` not empty, sample i sees component `component`'s scattering
+// and extinction times scale[i] (an aerosol family: the tables hold optical
+// lengths, which its amount does not change).
+void evaluate_sky_split(const SkyModel& model, std::span<const SkySample> samples, std::span<glm::vec3> out,
+                        std::span<const float> scale = {}, int component = -1);
 
 // Validates the settings (throws skybake::Error naming the flag) and sets up
 // the per-pixel parameters shared by the CPU and CUDA renderers.

@@ -229,15 +229,22 @@ void evaluate_sky(const SkyModel& model, std::span<const SkySample> samples, std
     });
 }
 
-void sky::evaluate_sky_split(const SkyModel& model, std::span<const SkySample> samples, std::span<glm::vec3> out) {
-    const sky::AtmosphereHD& hd = sky::atmosphere_hd(model);
+void sky::evaluate_sky_split(const SkyModel& model, std::span<const SkySample> samples, std::span<glm::vec3> out,
+                             std::span<const float> scale, int component) {
+    const sky::AtmosphereHD& hd0 = sky::atmosphere_hd(model);
     const Atmosphere& atm = model.atmosphere();
     const std::size_t n = atm.components.size();
     assert(out.size() == samples.size() * n);
+    assert(scale.empty() || (scale.size() == samples.size() && component >= 0 && std::size_t(component) < n));
     const int steps = model.options().steps;
     const int spacing = model.options().uniform_steps ? sky::kStepsUniform : sky::kStepsGraded;
     parallel_for(samples.size(), 1024, [&](std::size_t begin, std::size_t end) {
+        sky::AtmosphereHD hd = hd0;
         for (std::size_t i = begin; i < end; ++i) {
+            if (!scale.empty()) {
+                hd.comp[component].sca = hd0.comp[component].sca * scale[i];
+                hd.comp[component].ext = hd0.comp[component].ext * scale[i];
+            }
             glm::vec3 parts[sky::kMaxComponents];
             sky::seed_sky_sum_split(hd, sky::make_observer(atm, samples[i]), steps, spacing, parts);
             for (std::size_t k = 0; k < n; ++k)

@@ -133,6 +133,18 @@ export class NeuralSky {
       this.multipleMax = e.multiple_max.map((m) => finiteNumber(m, 'encoding.multiple_max'));
     }
     const outputs = factored ? 3 * this.terms.length + (this.multipleMax ? 3 : 0) : 4;
+    // An aerosol family: the amount of one component is a fifth input, set at
+    // run time (the `aerosol` property, a multiple of the atmosphere's).
+    this.family = null;
+    if (e.family !== undefined) {
+      const range = e.family.aerosol_range;
+      if (this.outputKind !== 'residual' || this.multipleMax || typeof e.family.component !== 'string' ||
+          !Array.isArray(range) || range.length !== 2 || !(range[0] > 0) || !(range[1] > range[0]))
+        fail('encoding.family needs residual outputs of single scattering, a component and aerosol_range [min, max]');
+      const lo = Math.log(finiteNumber(range[0], 'aerosol_range')), hi = Math.log(finiteNumber(range[1], 'aerosol_range'));
+      this.family = { component: e.family.component, min: range[0], max: range[1], a: f(2 / (hi - lo)), b: f(-(hi + lo) / (hi - lo)) };
+    }
+    this._aerosol = 1;
     const a = d.atmosphere ?? fail('no atmosphere');
     if (this.outputKind === 'residual') {
       // The march's atmosphere: its exponential components, and per term its component's scattering.
@@ -140,7 +152,8 @@ export class NeuralSky {
       this.ext = [];
       for (const c of a.components ?? fail('atmosphere.components is missing')) {
         if ((c.profile?.type ?? 'exponential') !== 'exponential') continue;
-        const ext = { H: finiteNumber(c.profile?.scale_height_km ?? 8, 'scale_height_km'), beta: vec3(c.extinction_per_km, 'extinction_per_km'), name: c.name };
+        const ext = { H: finiteNumber(c.profile?.scale_height_km ?? 8, 'scale_height_km'), beta: vec3(c.extinction_per_km, 'extinction_per_km'), name: c.name,
+          family: this.family?.component === c.name };
         this.ext.push(ext);
         for (const t of this.terms)
           if (t.component === c.name) {
@@ -150,6 +163,8 @@ export class NeuralSky {
       }
       if (this.ext.length > 4 || this.terms.some((t) => t.ext === undefined))
         fail('residual outputs need at most 4 exponential components, every scattering one among them');
+      if (this.family && !this.terms.some((t) => t.component === this.family.component))
+        fail(`the family's component '${this.family.component}' is not a scattering component`);
     }
     this.R0 = finiteNumber(a.planet_radius_km, 'atmosphere.planet_radius_km');
     this.Rtop = finiteNumber(a.top_radius_km, 'atmosphere.top_radius_km');
@@ -157,7 +172,7 @@ export class NeuralSky {
     this.scaleHeight = first?.profile?.scale_height_km ?? 8;
     // Sub-networks: one shared with every output, or one per output.
     const shared = t.kind === 'shared';
-    this.widths = [4, ...hidden, shared ? outputs : 1];
+    this.widths = [this.family ? 5 : 4, ...hidden, shared ? outputs : 1];
     const subnets = shared ? 1 : outputs;
     const w = d.weights;
     if (!Array.isArray(w) || w.length !== subnets) fail(`weights must hold ${subnets} sub-network(s)`);
@@ -172,8 +187,24 @@ export class NeuralSky {
     this.weightCount = params * subnets;
   }
 
-  // The network's four inputs (mlp_hd.h's encode_inputs).
+  // An aerosol family's amount, a multiple of its atmosphere's, within the
+  // trained range; 1 (and only 1) for other networks.
+  get aerosol() { return this._aerosol; }
+  set aerosol(value) {
+    const ok = this.family ? value >= this.family.min * (1 - 1e-9) && value <= this.family.max * (1 + 1e-9) : value === 1;
+    if (!ok) fail(this.family ? `aerosol ${value} is outside the family's range [${this.family.min}, ${this.family.max}]`
+      : 'aerosol: this network is not of an aerosol family');
+    this._aerosol = value;
+  }
+
+  // The network's inputs (mlp_hd.h's encode_inputs), with an aerosol family's fifth.
   encodeInputs(cosViewZenith, cosViewSun, cosSunZenith, density) {
+    const four = this.encodeFour(cosViewZenith, cosViewSun, cosSunZenith, density);
+    if (this.family) four.push(f(f(this.family.a * f(Math.log(f(this._aerosol)))) + this.family.b));
+    return four;
+  }
+
+  encodeFour(cosViewZenith, cosViewSun, cosSunZenith, density) {
     const cz = f(cosViewZenith);
     if (this.inputs !== 'horizon') return [cz, f(cosViewSun), f(cosSunZenith), f(density)];
     const R0 = f(this.R0), top = f(f(this.Rtop) - R0), two = f(2 * R0);
@@ -252,8 +283,13 @@ export class NeuralSky {
       q = q > 0 ? q : 0;
       return f(q / f(f(Math.sqrt(f(q + f(R0 * R0)))) + R0));
     };
-    const ext = this.ext;
+    // An aerosol family scales its component's coefficients; its march takes the
+    // view's depth as Chapman integrals from the observer (mlp_hd.h).
+    const k = f(this._aerosol);
+    const ext = this.ext.map((e) => ({ ...e, beta: e.family ? e.beta.map((b) => f(f(b) * k)) : e.beta }));
+    const termBeta = this.terms.map((t) => (t.component === this.family?.component ? t.beta.map((b) => f(f(b) * k)) : t.beta));
     const prev = ext.map((e) => f(Math.exp(f(-h / f(e.H)))));
+    const obs = prev.slice();
     const tau = [0, 0, 0];
     let tPrev = 0;
     for (let part = 0; part < 2; ++part) {
@@ -275,11 +311,13 @@ export class NeuralSky {
         const rp = f(R0 + hp);
         const cosChi = f(f(f(r * muS) + f(t * nu)) / rp);
         const sun = [0, 0, 0];
+        if (this.family) tau.fill(0);
         const dens = ext.map((e, i) => {
           const H = f(e.H);
           const rhoP = f(Math.exp(f(-hp / H)));
           sumRho[i] = f(sumRho[i] + f(rhoP * dt));
-          const view = f(f(0.5 * f(rhoP + prev[i])) * f(t - tPrev));
+          const view = this.family ? chapmanSegment(R0, H, h, mu, obs[i], hp, f(f(f(r * mu) + t) / rp), rhoP)
+            : f(f(0.5 * f(rhoP + prev[i])) * f(t - tPrev));
           const depth = chapmanDepth(hp, R0, H, cosChi, rhoP);
           for (let ch = 0; ch < 3; ++ch) {
             tau[ch] = f(tau[ch] + f(f(e.beta[ch]) * view));
@@ -292,7 +330,7 @@ export class NeuralSky {
         for (let ch = 0; ch < 3; ++ch) {
           const tr = f(f(Math.exp(f(-f(tau[ch] + sun[ch])))) * dt);
           this.terms.forEach((term, k2) => {
-            partSum[3 * k2 + ch] = f(partSum[3 * k2 + ch] + f(f(f(term.beta[ch]) * dens[term.ext]) * tr));
+            partSum[3 * k2 + ch] = f(partSum[3 * k2 + ch] + f(f(f(termBeta[k2][ch]) * dens[term.ext]) * tr));
           });
         }
       }

@@ -27,18 +27,20 @@ void main() {
 }
 `;
 
-// skybake_sky() comes first (the exported function), then this.
-const FRAGMENT = /* glsl */ `
+// skybake_sky() comes first (the exported function), then this. A network of
+// an aerosol family takes its amount as a fifth argument.
+const fragment = (family) => /* glsl */ `
 varying vec3 vWorldPosition;
 uniform vec3 sunPosition;
 uniform vec3 up;
 uniform float density;
+uniform float aerosol;
 uniform float sunIrradiance;
 void main() {
   vec3 v = normalize(vWorldPosition - cameraPosition);
   vec3 s = normalize(sunPosition);
   vec3 u = normalize(up);
-  vec3 L = skybake_sky(clamp(dot(v, u), -1.0, 1.0), clamp(dot(v, s), -1.0, 1.0), clamp(dot(s, u), -1.0, 1.0), density);
+  vec3 L = skybake_sky(clamp(dot(v, u), -1.0, 1.0), clamp(dot(v, s), -1.0, 1.0), clamp(dot(s, u), -1.0, 1.0), density${family ? ', aerosol' : ''});
   gl_FragColor = vec4(max(L, vec3(0.0)) * sunIrradiance, 1.0);
   #include <tonemapping_fragment>
   #include <colorspace_fragment>
@@ -63,10 +65,11 @@ export class NeuralSky extends Mesh {
         sunPosition: { value: new Vector3(0, 1, 0) },
         up: { value: new Vector3(0, 1, 0) },
         density: { value: 1 },
+        aerosol: { value: 1 },
         sunIrradiance: { value: 1 },
       },
       vertexShader: VERTEX,
-      fragmentShader: glsl + FRAGMENT,
+      fragmentShader: glsl + fragment(network.family !== null),
       side: BackSide,
       depthWrite: false,
     });
@@ -75,6 +78,14 @@ export class NeuralSky extends Mesh {
     this.type = 'NeuralSky';
     this.network = network;
     this.projector = new SkyProjector(order, horizonRule());
+  }
+
+  // A network of an aerosol family: its amount, a multiple of its
+  // atmosphere's, for the sky and for shLight().
+  setAerosol(amount) {
+    this.network.aerosol = amount; // checks the range
+    this.material.uniforms.aerosol.value = amount;
+    return this;
   }
 
   // The sun at elevation and azimuth (degrees; azimuth from +z towards +x,

@@ -40,13 +40,13 @@ function samples(count, seed) {
   return out;
 }
 
-function libraryRadiance(model, rows) {
+function libraryRadiance(model, rows, extra = []) {
   const dir = mkdtempSync(join(tmpdir(), 'skybake-web-'));
   try {
     const input = join(dir, 'in.csv'), output = join(dir, 'out.csv');
     writeFileSync(input, 'cos_view_zenith,cos_view_sun,cos_sun_zenith,density\n' +
       rows.map((r) => r.map((x) => x.toPrecision(9)).join(',')).join('\n') + '\n');
-    execFileSync(cli, ['--quiet', 'sky', 'eval', '--model', model, '--input', input, '--output', output]);
+    execFileSync(cli, ['--quiet', 'sky', 'eval', '--model', model, '--input', input, '--output', output, ...extra]);
     const lines = readFileSync(output, 'utf8').trim().split('\n').slice(1);
     return { rows: rows.map((r) => r.map((x) => Number(x.toPrecision(9)))), ref: lines.map((l) => l.split(',').map(Number)) };
   } finally {
@@ -54,17 +54,20 @@ function libraryRadiance(model, rows) {
   }
 }
 
-for (const [file, what] of [
+for (const [file, what, aerosol] of [
   ['neural/v1_paper.json', 'the seed topology, seed inputs, log brightness'],
   ['neural/v1_shared_linear.json', 'a shared network, linear brightness'],
   ['neural/v3_earth_default.json', 'horizon inputs, phase-factored outputs'],
   ['neural/v3_earth_residual.json', 'the default: horizon inputs, residual outputs'],
   ['neural/v3_earth_multiple.json', 'the default with multiple scattering: residual outputs and their term'],
+  ['neural/v3_earth_family.json', 'an aerosol family at 5 times the aerosol', 5],
+  ['neural/v3_earth_family.json', 'an aerosol family at its hazy end, 32 times', 32],
 ]) {
   test(`${file} (${what}) matches the library`, { skip: !cli || !data ? 'SKYBAKE_CLI and SKYBAKE_TEST_DATA not set' : false }, () => {
     const model = join(data, file);
     const sky = new NeuralSky(readFileSync(model, 'utf8'));
-    const { rows, ref } = libraryRadiance(model, samples(3000, 17));
+    if (aerosol !== undefined) sky.aerosol = aerosol;
+    const { rows, ref } = libraryRadiance(model, samples(3000, 17), aerosol !== undefined ? ['--aerosol', String(aerosol)] : []);
     assert.equal(ref.length, rows.length);
     let worst = 0, lit = 0;
     rows.forEach((r, i) => {
@@ -84,6 +87,14 @@ for (const [file, what] of [
     console.log(`${file}: max relative error ${worst.toExponential(2)} over ${lit} lit samples`);
   });
 }
+
+test('an aerosol amount outside the family, or for a network without one, is one clear error', { skip: !data ? 'SKYBAKE_TEST_DATA not set' : false }, () => {
+  const family = new NeuralSky(readFileSync(join(data, 'neural', 'v3_earth_family.json'), 'utf8'));
+  assert.throws(() => { family.aerosol = 40; }, /outside the family's range \[1, 32\]/);
+  const plain = new NeuralSky(readFileSync(join(data, 'neural', 'v3_earth_residual.json'), 'utf8'));
+  assert.throws(() => { plain.aerosol = 2; }, /not of an aerosol family/);
+  assert.equal(plain.aerosol, 1);
+});
 
 test('a file that is not a weights file is one clear error', () => {
   assert.throws(() => new NeuralSky('{"format": "something-else"}'), /not a weights file/);
