@@ -137,6 +137,7 @@ void add_fly(CLI::App& sub) {
     };
     auto o = std::make_shared<Opts>();
     sub.add_option("--model", o->model.path, "Trained neural sky (weights JSON from `skybake sky train`)")->required();
+    o->model.add_aerosol(sub);
     sub.add_option("--path", o->path,
                    "sea-to-space (2 m to 10,000 km), or a JSON file {\"keyframes\": [{\"t\": 0, \"altitude_km\": "
                    "0.002, \"yaw_deg\", \"pitch_deg\", \"fov_deg\", \"sun_elevation_deg\", \"sun_azimuth_deg\"}, "
@@ -180,7 +181,7 @@ void add_fly(CLI::App& sub) {
             throw UsageError("unknown ground model '" + o->ground + "'; use lambert or as-published", "--ground");
         options.published_ground = o->ground != "lambert";
         const std::vector<Keyframe> keys = o->path == "sea-to-space" ? sea_to_space() : load_path(o->path);
-        const NeuralSky net = load_neural_sky(o->model.path);
+        const NeuralSky net = o->model.load_weights();
         const SkyModel model = neural_reference_model(net);
 
         const auto t0 = std::chrono::steady_clock::now();

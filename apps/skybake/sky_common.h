@@ -80,10 +80,20 @@ struct ModelFlag {
 
     void add(CLI::App& sub) {
         sub.add_option("--model", path, "Use a trained neural sky (weights JSON from `skybake sky train`)");
+        add_aerosol(sub);
+    }
+    void add_aerosol(CLI::App& sub) {
         sub.add_option("--aerosol", aerosol,
                        "With --model of an aerosol family (sky train --aerosol-range): the aerosol amount, a "
                        "multiple of its atmosphere's")
             ->capture_default_str();
+    }
+    // The weights file at `path` with --aerosol applied (a usage error outside the family).
+    NeuralSky load_weights() const {
+        NeuralSky net = load_neural_sky(path);
+        net.aerosol = aerosol;
+        parse_flag("--aerosol", [&] { net.validate("aerosol"); return 0; });
+        return net;
     }
     bool active() const { return !path.empty(); }
     NeuralSky load(const CLI::App& sub, const AtmosphereFlags& atm) const {
@@ -92,10 +102,7 @@ struct ModelFlag {
         for (const char* flag : {"--method", "--table-rule", "--steps", "--uniform-steps", "--shells", "--cosines",
                                  "--paper-r", "--paper-m", "--scattering", "--multiple-method", "--scattering-orders"})
             refuse_if_given(sub, flag, "to a neural sky (--model)");
-        NeuralSky net = load_neural_sky(path);
-        net.aerosol = aerosol;
-        parse_flag("--aerosol", [&] { net.validate("aerosol"); return 0; });
-        return net;
+        return load_weights();
     }
 };
 

@@ -28,6 +28,7 @@ void add_view_planet(CLI::App& group) {
     };
     auto o = std::make_shared<Opts>();
     sub->add_option("--model", o->model.path, "Trained neural sky (weights JSON from `skybake sky train`)")->required();
+    o->model.add_aerosol(*sub);
     sub->add_option("--size", o->size, "Window size WxH in pixels")->capture_default_str();
     sub->add_option("--altitude-km", o->v.altitude_km, "Starting altitude, km")
         ->check(real_in(0.0001, 1e6, "km"))
@@ -79,7 +80,7 @@ void add_view_planet(CLI::App& group) {
             if (sub->count("--frames") > 0)
                 throw UsageError("--frames is for the window; --screenshot draws the starting view once", "--frames");
         }
-        const NeuralSky net = load_neural_sky(o->model.path);
+        const NeuralSky net = o->model.load_weights();
         const SkyModel model = neural_reference_model(net);
         if (o->screenshot.empty()) {
             run_planet_viewer(model, &net, o->v);
