@@ -219,6 +219,7 @@ std::string flag_for_field(const std::string& where) {
         {"inputs", "--inputs"},
         {"outputs", "--outputs"},
         {"family_component", "--aerosol-range"},
+        {"hard_share", "--hard-share"},
         {"aerosol", "--aerosol"},
         {"name", "--name"},
         {"kind", "--kind"},

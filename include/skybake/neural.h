@@ -285,6 +285,10 @@ struct NeuralTrainOptions {
     // aerosol_max] times the atmosphere's. Empty: one atmosphere.
     std::string family_component;
     double aerosol_min = 1.0, aerosol_max = 1.0;
+    // Importance sampling: this share of the training samples (not the
+    // held-out ones) is drawn where the sky is hard instead of uniformly: a
+    // third each near the horizon, the sun's aureole and the terminator.
+    double hard_share = 0.0;
 };
 
 // One point of the learning curve: after Adam epoch `epoch` (phase "adam") or

@@ -120,7 +120,11 @@ std::vector<float> draw_aerosol(const NeuralEncoding& encoding, std::size_t n, s
 int family_component_index(const NeuralEncoding& encoding, const Atmosphere& atmosphere);
 // n samples (seed) of model's table path with their encoded targets.
 TrainingData make_training_data(const SkyModel& model, const NeuralEncoding& encoding, std::size_t n,
-                                std::uint64_t seed, Device device);
+                                std::uint64_t seed, Device device, double hard_share = 0.0);
+// n samples where the sky is hard for a network (NeuralTrainOptions::hard_share),
+// a third each: views within sin 2° (in cosine) of the geometric horizon, within 15° of the sun,
+// and suns from −15° to 5°; densities uniform in (0, 1] as draw_sky_samples.
+std::vector<SkySample> draw_hard_samples(std::size_t n, std::uint64_t seed, const Atmosphere& atmosphere);
 
 // train_neural_sky after its data: Adam, then Levenberg–Marquardt, on `net`
 // (its topology, encoding and atmosphere set; its weights are replaced).

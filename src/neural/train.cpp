@@ -98,10 +98,62 @@ int neural::family_component_index(const NeuralEncoding& enc, const Atmosphere& 
     return -1;
 }
 
+std::vector<SkySample> neural::draw_hard_samples(std::size_t n, std::uint64_t seed, const Atmosphere& atm) {
+    const double pi = 3.14159265358979323846, R0 = atm.planet_radius_km;
+    std::vector<SkySample> out(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        SplitMix rng{seed * 0xD1B54A32D192ED03ull + i * 0x9E3779B97F4A7C15ull + 0x4a4dull};
+        rng.next();
+        for (;;) {
+            const double rho = 1.0 - rng.uniform(); // (0, 1], as the uniform samples
+            const double r = R0 + atm.altitude_from_density(rho);
+            const double mu_h = -std::sqrt(std::max(0.0, 1.0 - (R0 / r) * (R0 / r)));
+            double mu = 0.0, mu_s = 0.0, nu = 0.0;
+            auto around = [&](double phi) { // ν from the two zenith cosines and the azimuth between them
+                return mu * mu_s + std::sqrt(std::max(0.0, (1.0 - mu * mu) * (1.0 - mu_s * mu_s))) * std::cos(phi);
+            };
+            switch (i % 3) {
+            case 0: // the horizon: within sin 2° in cosine of the geometric horizon, the sun above −20°
+                mu = std::clamp(mu_h + std::sin(2.0 * pi / 180.0) * (2.0 * rng.uniform() - 1.0), -1.0, 1.0);
+                mu_s = std::sin((-20.0 + 110.0 * rng.uniform()) * pi / 180.0);
+                nu = around(2.0 * pi * rng.uniform());
+                break;
+            case 1: { // the aureole: within 15° of the sun, uniform in solid angle
+                mu_s = std::sin((-10.0 + 100.0 * rng.uniform()) * pi / 180.0);
+                const double cg = 1.0 - (1.0 - std::cos(15.0 * pi / 180.0)) * rng.uniform();
+                const double sg = std::sqrt(std::max(0.0, 1.0 - cg * cg)), psi = 2.0 * pi * rng.uniform();
+                const double ss = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
+                // the sun (ss, 0, μs); e1 = (−μs, 0, ss), e2 = (0, 1, 0)
+                mu = cg * mu_s + sg * std::cos(psi) * ss;
+                nu = cg;
+                break;
+            }
+            default: // the terminator: the sun from −15° to 5°, any view
+                mu = 2.0 * rng.uniform() - 1.0;
+                mu_s = std::sin((-15.0 + 20.0 * rng.uniform()) * pi / 180.0);
+                nu = around(2.0 * pi * rng.uniform());
+                break;
+            }
+            const SkySample x{float(mu), float(std::clamp(nu, -1.0, 1.0)), float(mu_s), float(rho)};
+            if (is_valid_sky_sample(x, 0.0)) {
+                out[i] = x;
+                break;
+            }
+        }
+    }
+    return out;
+}
+
 TrainingData neural::make_training_data(const SkyModel& model, const NeuralEncoding& enc, std::size_t n,
-                                        std::uint64_t seed, Device device) {
+                                        std::uint64_t seed, Device device, double hard_share) {
     DataSet d;
-    const std::vector<SkySample> s = draw_sky_samples(n, seed);
+    std::vector<SkySample> s = draw_sky_samples(n, seed);
+    if (hard_share > 0.0) { // every k-th sample from where the sky is hard
+        const std::size_t hard = std::size_t(std::llround(hard_share * double(n)));
+        const std::vector<SkySample> h = draw_hard_samples(hard, seed ^ 0x4a4d4a4dull, model.atmosphere());
+        for (std::size_t j = 0; j < hard; ++j)
+            s[std::min(n - 1, std::size_t(double(j) / hard_share))] = h[j];
+    }
     MlpHD hd;
     set_encoding_hd(enc, model.atmosphere(), hd);
     hd.width[0] = enc.input_count();
@@ -403,6 +455,8 @@ NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, s
         throw Error("epochs and LM iterations must be 0 to 100000", "adam_epochs/lm_iterations");
     if (o.batch < 1 || o.batch > o.samples)
         throw Error("the mini-batch must hold 1 to `samples` samples", "batch");
+    if (!(o.hard_share >= 0.0 && o.hard_share <= 1.0))
+        throw Error("the share of hard samples must be in [0, 1]", "hard_share");
     if (!(o.learning_rate > 0.0 && o.learning_rate_final > 0.0 && o.learning_rate < 10.0))
         throw Error("learning rates must be positive (and below 10)", "learning_rate");
     if ((o.brightness == BrightnessEncoding::Log || has_phase_terms(o.outputs)) &&
@@ -416,7 +470,8 @@ NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, s
     net.encoding = make_training_encoding(model, o);
     net.topology.outputs = net.encoding.output_count();
     net.topology.inputs = net.encoding.input_count();
-    const DataSet train = make_training_data(model, net.encoding, o.samples, stream_seed(o.seed, 0), o.device);
+    const DataSet train =
+        make_training_data(model, net.encoding, o.samples, stream_seed(o.seed, 0), o.device, o.hard_share);
     const DataSet held = make_training_data(model, net.encoding, o.heldout_samples, stream_seed(o.seed, 1), o.device);
     return train_network(std::move(net), train, held, o, curve, t0);
 }
