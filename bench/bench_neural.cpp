@@ -117,9 +117,10 @@ void BM_NeuralScalarOneCore(benchmark::State& state) {
 }
 
 // The default network's size with phase-factored (0) or residual (1) outputs,
-// horizon inputs: what the analytic march of the residual costs per sample in
-// the scalar pass (the exported shaders' arithmetic), against the same
-// network without it, measured in the same run.
+// or residual outputs of an aerosol family (2: a fifth input and the view's
+// depth from Chapman integrals), horizon inputs: what the analytic march of
+// the residual costs per sample in the scalar pass (the exported shaders'
+// arithmetic), against the same network without it, measured in the same run.
 void BM_NeuralScalarOutputs(benchmark::State& state) {
     const double base = tables_rate();
     NeuralSky net = random_net("shared:16x12");
@@ -130,9 +131,15 @@ void BM_NeuralScalarOutputs(benchmark::State& state) {
         net.encoding.terms.push_back({c.name, c.phase, c.phase_g, glm::dvec3(1.0)});
     }
     net.topology.outputs = net.encoding.output_count();
+    if (state.range(0) == 2) {
+        net.encoding.family_component = "mie";
+        net.encoding.aerosol_max = 8.0;
+        net.topology.inputs = net.encoding.input_count();
+        net.aerosol = 3.0;
+    }
     net.weights.resize(std::size_t(net.topology.weight_count()), 0.01f);
-    state.SetLabel(fmt::format("shared:16x12, horizon/{} ({} weights)", output_encoding_name(net.encoding.outputs),
-                               net.topology.weight_count()));
+    state.SetLabel(fmt::format("shared:16x12, horizon/{}{} ({} weights)", output_encoding_name(net.encoding.outputs),
+                               state.range(0) == 2 ? ", aerosol family" : "", net.topology.weight_count()));
     const neural::MlpHD hd = neural::make_mlp_hd(net);
     scalar_pass(state, hd, base);
 }
@@ -188,7 +195,7 @@ void compare_sample_counts(const std::filesystem::path& dir) {
 BENCHMARK(BM_SkyTables)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_NeuralBatch)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_NeuralScalarOneCore)->Arg(0)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_NeuralScalarOutputs)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_NeuralScalarOutputs)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_TrainPaper800k)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 
 int main(int argc, char** argv) {
