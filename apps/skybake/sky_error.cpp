@@ -64,6 +64,9 @@ void add_sky_error(CLI::App& group) {
                                 {"topology", net.topology.name()},
                                 {"weights", net.topology.weight_count()},
                                 {"atmosphere", net.atmosphere.name},
+                                {"aerosol_range", net.encoding.has_family()
+                                                      ? nlohmann::json{net.encoding.aerosol_min, net.encoding.aerosol_max}
+                                                      : nlohmann::json(nullptr)},
                                 {"samples", o->e.samples},
                                 {"relative_error", {{"all", stats_json(r.all)},
                                                     {"day", stats_json(r.day)},
@@ -85,8 +88,13 @@ void add_sky_error(CLI::App& group) {
             print_json(j);
             return;
         }
-        std::string t = fmt::format("{} ({} weights) on '{}', {} held-out samples\n", net.topology.name(),
-                                    net.topology.weight_count(), net.atmosphere.name, o->e.samples);
+        const std::string family =
+            net.encoding.has_family() ? fmt::format(" with {} amounts {:g} to {:g} (log-uniform)",
+                                                    net.encoding.family_component, net.encoding.aerosol_min,
+                                                    net.encoding.aerosol_max)
+                                      : std::string();
+        std::string t = fmt::format("{} ({} weights) on '{}'{}, {} held-out samples\n", net.topology.name(),
+                                    net.topology.weight_count(), net.atmosphere.name, family, o->e.samples);
         t += "relative RGB error |dI|/|I|   count      mean      p50       p95       p99       max\n";
         auto row = [&](const char* name, const ErrorStats& s) {
             t += fmt::format("{:<28} {:>6}  {:>8.3f}% {:>8.3f}% {:>8.3f}% {:>8.3f}% {:>8.2f}%\n", name, s.count,
