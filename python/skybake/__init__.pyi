@@ -211,6 +211,7 @@ def train_sky(
     steps: int = 64,
     device: str = "cpu",
     aerosol_range: Optional[tuple[float, float]] = None,
+    hard_share: float = 0.0,
     progress: Progress = None,
 ) -> NeuralSky: ...
 

@@ -247,7 +247,8 @@ void bind_sky(py::module_& m) {
         [](Atmosphere atmosphere, const std::string& topology, const std::string& inputs,
            std::optional<std::string> outputs, std::size_t samples, int adam_epochs, int lm_iterations,
            std::uint64_t seed, const std::string& brightness, const std::string& table_rule, int steps,
-           const std::string& device, std::optional<std::pair<double, double>> aerosol_range, py::object progress) {
+           const std::string& device, std::optional<std::pair<double, double>> aerosol_range, double hard_share,
+           py::object progress) {
             atmosphere.table_rule = parse_table_rule(table_rule, "table_rule");
             atmosphere.validate();
             if (steps < 1 || steps > 4096)
@@ -264,6 +265,7 @@ void bind_sky(py::module_& m) {
             // As `sky train`: default_output_encoding (residual for single scattering).
             o.outputs = outputs ? parse_output_encoding(*outputs, "outputs") : default_output_encoding(atmosphere);
             o.device = parse_device(device);
+            o.hard_share = hard_share;
             if (aerosol_range) {
                 o.family_component = "mie";
                 o.aerosol_min = aerosol_range->first;
@@ -286,12 +288,14 @@ void bind_sky(py::module_& m) {
         py::arg("outputs") = py::none(), py::arg("samples") = 800000,
         py::arg("adam_epochs") = 60, py::arg("lm_iterations") = 20, py::arg("seed") = 1,
         py::arg("brightness") = "log", py::arg("table_rule") = "refined", py::arg("steps") = kTrainingTargetSteps,
-        py::arg("device") = "cpu", py::arg("aerosol_range") = py::none(), py::arg("progress") = py::none(),
+        py::arg("device") = "cpu", py::arg("aerosol_range") = py::none(), py::arg("hard_share") = 0.0,
+        py::arg("progress") = py::none(),
         "Trains a network on the table path of `atmosphere` (Adam, then Levenberg–Marquardt), as "
         "`skybake sky train`: by default the best small network (shared:16x12, horizon inputs, residual "
         "outputs; radiance outputs with multiple scattering), targets from the refined 512 x 256 tables with 64 "
         "steps. aerosol_range=(min, max): one network for the family of atmospheres whose 'mie' amount is that "
-        "multiple of the atmosphere's, chosen at run time (NeuralSky.aerosol). The seed's network: topology='paper', inputs='seed', outputs='radiance', brightness='linear' "
+        "multiple of the atmosphere's, chosen at run time (NeuralSky.aerosol). hard_share: the share of training "
+        "samples drawn near the horizon, the sun and the terminator (importance sampling; 0 by default). The seed's network: topology='paper', inputs='seed', outputs='radiance', brightness='linear' "
         "(and table_rule='as-published', steps=16 for its targets). Deterministic for a seed. "
         "topology: 'paper' (324 weights), 'independent:16x16', 'shared:64x64', ...");
 }

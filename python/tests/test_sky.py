@@ -93,6 +93,10 @@ def test_an_aerosol_family_takes_its_amount_at_run_time(earth):
     assert net.aerosol == 12.0
     plain = skybake.train_sky(earth, samples=2000, adam_epochs=1, lm_iterations=0)
     assert plain.aerosol_range is None
+    hard = skybake.train_sky(earth, samples=2000, adam_epochs=1, lm_iterations=0, hard_share=0.3)
+    assert np.abs(hard.weights - plain.weights).max() > 0.0
+    with pytest.raises(skybake.Error, match="hard"):
+        skybake.train_sky(earth, samples=2000, adam_epochs=1, lm_iterations=0, hard_share=2.0)
     with pytest.raises(skybake.Error, match="aerosol"):
         plain.aerosol = 2.0
 

@@ -75,6 +75,16 @@ TEST(NeuralCuda, EveryEncodingMatchesTheCpu) {
                              output_encoding_name(outputs));
                 expect_within_modelled_bound(net, samples, cpu, gpu);
             }
+    // An aerosol family: the fifth input and the scaled, Chapman-view march.
+    const NeuralSky family = with_family(
+        with_encoding(random_network("shared:16x12", 4), InputEncoding::Horizon, OutputEncoding::Residual, 12), 1.0,
+        32.0, 9.0, 13);
+    const auto samples = draw_sky_samples(50000, 22);
+    std::vector<glm::vec3> cpu(samples.size()), gpu(samples.size());
+    evaluate_neural_sky(family, samples, cpu);
+    evaluate_neural_sky_cuda(family, samples, gpu);
+    SCOPED_TRACE("shared:16x12, aerosol family at 9");
+    expect_within_modelled_bound(family, samples, cpu, gpu);
 }
 
 TEST(NeuralCuda, ThroughputChecksumEqualsTheCpus) {
