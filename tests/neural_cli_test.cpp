@@ -94,6 +94,8 @@ TEST(NeuralCli, TrainRejectsBadFlags) {
              {"--topology", "wide"},
              {"--topology", "independent:0"},
              {"--brightness", "cubic"},
+             {"--hard-share", "nan"},
+             {"--hard-share", "1.5"},
              {"--samples", "3"},
              {"--chart", dir + "/c.jpg"},
              {"--preset", "mars"}}) {

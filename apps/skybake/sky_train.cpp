@@ -80,7 +80,7 @@ void add_sky_train(CLI::App& group) {
     sub->add_option("--hard-share", o->t.hard_share,
                     "Share of the training samples drawn near the horizon, the sun and the terminator instead of "
                     "uniformly (importance sampling)")
-        ->check(CLI::Range(0.0, 1.0))
+        ->check(real_in(0.0, 1.0, ""))
         ->capture_default_str();
     sub->add_option("--aerosol-component", o->aerosol_component,
                     "With --aerosol-range: the scattering component whose amount varies")
