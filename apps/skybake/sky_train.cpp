@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "commands.h"
+#include "core/parse_number.h"
 #include "flags.h"
 #include "skybake/files.h"
 #include "sky_common.h"
@@ -117,15 +118,12 @@ void add_sky_train(CLI::App& group) {
             o->t.outputs = default_output_encoding(atm);
         o->t.log_range = o->log_range_decades * std::log(10.0);
         if (!o->aerosol_range.empty()) {
-            const std::size_t colon = o->aerosol_range.find(':');
-            char* end = nullptr;
-            const std::string a = o->aerosol_range.substr(0, colon);
-            const std::string b = colon == std::string::npos ? "" : o->aerosol_range.substr(colon + 1);
-            const double lo = std::strtod(a.c_str(), &end);
-            const bool a_ok = !a.empty() && *end == '\0';
-            const double hi = std::strtod(b.c_str(), &end);
-            if (colon == std::string::npos || !a_ok || b.empty() || *end != '\0')
-                throw UsageError(fmt::format("'{}' is not MIN:MAX (e.g. 1:32)", o->aerosol_range), "--aerosol-range");
+            const std::string_view range = o->aerosol_range;
+            const std::size_t colon = range.find(':');
+            double lo = 0.0, hi = 0.0;
+            if (colon == std::string_view::npos || !parse_decimal(range.substr(0, colon), lo) ||
+                !parse_decimal(range.substr(colon + 1), hi))
+                throw UsageError(fmt::format("'{}' is not MIN:MAX (e.g. 1:32)", range), "--aerosol-range");
             o->t.family_component = o->aerosol_component;
             o->t.aerosol_min = lo;
             o->t.aerosol_max = hi;
