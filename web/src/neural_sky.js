@@ -185,6 +185,7 @@ export class NeuralSky {
     this.outputs = outputs;
     this.topology = t.name ?? t.kind;
     this.weightCount = params * subnets;
+    this.scaleAerosol();
   }
 
   // An aerosol family's amount, a multiple of its atmosphere's, within the
@@ -195,6 +196,17 @@ export class NeuralSky {
     if (!ok) fail(this.family ? `aerosol ${value} is outside the family's range [${this.family.min}, ${this.family.max}]`
       : 'aerosol: this network is not of an aerosol family');
     this._aerosol = value;
+    this.scaleAerosol();
+  }
+
+  // The march's coefficients at the current aerosol amount (once per amount, not per sample).
+  scaleAerosol() {
+    if (this.outputKind !== 'residual') return;
+    const k = f(this._aerosol);
+    this.scaled = {
+      ext: this.ext.map((e) => ({ ...e, beta: e.family ? e.beta.map((b) => f(f(b) * k)) : e.beta })),
+      termBeta: this.terms.map((t) => (t.component === this.family?.component ? t.beta.map((b) => f(f(b) * k)) : t.beta)),
+    };
   }
 
   // The network's inputs (mlp_hd.h's encode_inputs), with an aerosol family's fifth.
@@ -285,9 +297,7 @@ export class NeuralSky {
     };
     // An aerosol family scales its component's coefficients; its march takes the
     // view's depth as Chapman integrals from the observer (mlp_hd.h).
-    const k = f(this._aerosol);
-    const ext = this.ext.map((e) => ({ ...e, beta: e.family ? e.beta.map((b) => f(f(b) * k)) : e.beta }));
-    const termBeta = this.terms.map((t) => (t.component === this.family?.component ? t.beta.map((b) => f(f(b) * k)) : t.beta));
+    const { ext, termBeta } = this.scaled;
     const prev = ext.map((e) => f(Math.exp(f(-h / f(e.H)))));
     const obs = prev.slice();
     const tau = [0, 0, 0];
