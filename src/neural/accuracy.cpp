@@ -5,7 +5,6 @@
 // model's marching sum.
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <optional>
 
 #include <fmt/format.h>
@@ -98,8 +97,9 @@ NeuralErrorReport neural::measure_approximation_error(const SkyModel& model, dou
             if (family)
                 scaled.emplace(scaled_atmosphere(*family, model.atmosphere(), amount), model.options());
             for (const PublishedView& v : published_views(o.view_width, o.view_height)) {
-                const Image a = render_sky(scaled ? *scaled : model, v.settings);
-                const Image b = render(v.settings, amount);
+                const SkyModel& reference = scaled ? *scaled : model;
+                const Image a = render_sky(reference, v.settings);
+                const Image b = render(v.settings, amount, reference);
                 ToneMap tm;
                 tm.exposure_ev = float(auto_exposure_ev(a));
                 const double psnr = image_psnr_db(a, b, tm);
@@ -124,20 +124,15 @@ NeuralErrorReport measure_neural_sky_error(const NeuralSky& net, const NeuralErr
     NeuralSky base = net; // a family's samples and views choose their own amounts
     base.aerosol = 1.0;
     const SkyModel model = neural_reference_model(base);
-    std::map<double, SkyModel> tables; // per aerosol amount of a family's views
     return neural::measure_approximation_error(
         model, net.encoding.max_n, o,
         [&](std::span<const SkySample> s, std::span<const float> aerosol, std::span<glm::vec3> out) {
             neural::evaluate_neural_sky_at(net, s, aerosol, out);
         },
-        [&](const SkyRenderSettings& v, double aerosol) {
-            // The ground and the sun disc from the tables of the atmosphere at this amount.
+        [&](const SkyRenderSettings& v, double aerosol, const SkyModel& tables) {
             NeuralSky at = net;
             at.aerosol = aerosol;
-            auto it = tables.find(aerosol);
-            if (it == tables.end())
-                it = tables.emplace(aerosol, neural_reference_model(at)).first;
-            return render_neural_sky(at, it->second, v);
+            return render_neural_sky(at, tables, v);
         },
         net.encoding.has_family() ? &net.encoding : nullptr);
 }

@@ -141,7 +141,9 @@ NeuralSky train_network(NeuralSky net, const TrainingData& train, const Training
 // its geometric middle; the evaluator and renderer receive the amounts (empty
 // and 1 without a family).
 using BatchSky = std::function<void(std::span<const SkySample>, std::span<const float> aerosol, std::span<glm::vec3>)>;
-using RenderSky = std::function<Image(const SkyRenderSettings&, double aerosol)>;
+// The renderer gets the view, the aerosol amount and the reference model at
+// that amount (its tables shade the ground and the sun disc).
+using RenderSky = std::function<Image(const SkyRenderSettings&, double aerosol, const SkyModel& tables)>;
 NeuralErrorReport measure_approximation_error(const SkyModel& model, double max_n, const NeuralErrorOptions& options,
                                               const BatchSky& evaluate, const RenderSky& render,
                                               const NeuralEncoding* family = nullptr);

@@ -233,7 +233,7 @@ NeuralErrorReport measure_sky_lookup_table_error(const SkyLookupTable& t, const 
         [&](std::span<const SkySample> s, std::span<const float>, std::span<glm::vec3> out) {
             evaluate_sky_lookup_table(t, s, out);
         },
-        [&](const SkyRenderSettings& v, double) {
+        [&](const SkyRenderSettings& v, double, const SkyModel&) {
             const sky::RenderHD p = sky::make_render_hd(model, v);
             return sky::render_pixels(p, [&](const glm::vec3& d) { return shade_ray_approximate(p, sky, d); });
         });
