@@ -130,20 +130,19 @@ void set_encoding_hd(const NeuralEncoding& e, const Atmosphere& atmosphere, MlpH
 }
 
 void check_family(const NeuralEncoding& e, const Atmosphere& atmosphere, const std::string& where) {
-    const std::string& fw = where;
     if (e.outputs != OutputEncoding::Residual || e.multiple)
         throw Error("an aerosol family needs residual outputs of single scattering (its analytic march scales the "
                     "aerosol); multiple scattering is not supported in a family",
-                    fw);
+                    where);
     if (std::none_of(e.terms.begin(), e.terms.end(), [&](const PhaseTerm& t) { return t.component == e.family_component; }))
         throw Error(fmt::format("the family's component '{}' is not a scattering component of atmosphere '{}'",
                                 e.family_component, atmosphere.name),
-                    fw);
+                    where);
     if (!(std::isfinite(e.aerosol_min) && std::isfinite(e.aerosol_max) && e.aerosol_min > 0.0 &&
           e.aerosol_max > e.aerosol_min * 1.001 && e.aerosol_max <= e.aerosol_min * 1e4))
         throw Error(fmt::format("the aerosol range [{}, {}] must be positive, increasing and span at most 1e4",
                                 e.aerosol_min, e.aerosol_max),
-                    fw);
+                    where);
 }
 
 void check_residual_atmosphere(const NeuralEncoding& e, const Atmosphere& atmosphere, const std::string& where) {
