@@ -220,6 +220,7 @@ std::string flag_for_field(const std::string& where) {
         {"outputs", "--outputs"},
         {"family_component", "--aerosol-range"},
         {"hard_share", "--hard-share"},
+        {"flight_share", "--flight-share"},
         {"aerosol", "--aerosol"},
         {"name", "--name"},
         {"kind", "--kind"},

@@ -21,7 +21,7 @@ void add_sky_train(CLI::App& group) {
         NeuralTrainOptions t;
         // The defaults: the best network of at most 400 weights (docs/neural.md, "Size and accuracy").
         std::string topology = kDefaultTopology, inputs = "horizon", outputs = "phase-factored", brightness = "log";
-        std::string output, curve, chart, device = "cpu", aerosol_range, aerosol_component = "mie";
+        std::string output, curve, chart, device = "cpu", aerosol_range, aerosol_component = "mie", multiple_term = "march";
         double log_range_decades = 6.0;
         int steps = kTrainingTargetSteps;
         bool json = false;
@@ -83,6 +83,14 @@ void add_sky_train(CLI::App& group) {
                     "uniformly (importance sampling)")
         ->check(real_in(0.0, 1.0, ""))
         ->capture_default_str();
+    sub->add_option("--flight-share", o->t.flight_share,
+                    "Share of the training samples drawn as a flight's (altitude uniform to 60 km, the sun down to "
+                    "-20 degrees) instead of uniformly (default: 0.3 with multiple scattering, else 0)")
+        ->check(real_in(0.0, 1.0, ""));
+    sub->add_option("--multiple-term", o->multiple_term,
+                    "With --scattering multiple and residual outputs, the multiply scattered light: march (a "
+                    "correction of an isotropic march of the sky's mean radiance) or log (log-encoded over 12 decades)")
+        ->capture_default_str();
     sub->add_option("--aerosol-component", o->aerosol_component,
                     "With --aerosol-range: the scattering component whose amount varies")
         ->capture_default_str();
@@ -117,6 +125,13 @@ void add_sky_train(CLI::App& group) {
         } else
             o->t.outputs = default_output_encoding(atm);
         o->t.log_range = o->log_range_decades * std::log(10.0);
+        if (given(*sub, "--multiple-term") &&
+            (atm.scattering == Scattering::Single || o->t.outputs != OutputEncoding::Residual))
+            throw UsageError("the multiple-scattering term is for residual outputs with --scattering multiple",
+                             "--multiple-term");
+        if (o->multiple_term != "march" && o->multiple_term != "log")
+            throw UsageError(fmt::format("'{}' is not march or log", o->multiple_term), "--multiple-term");
+        o->t.multiple_march = o->multiple_term == "march";
         if (!o->aerosol_range.empty()) {
             const std::string_view range = o->aerosol_range;
             const std::size_t colon = range.find(':');

@@ -149,6 +149,16 @@ struct NeuralEncoding {
     // (kMultipleLogRange in src/neural/mlp_hd.h).
     bool multiple = false;
     glm::dvec3 multiple_max{1.0};
+    // Or, with multiple_psi set, the term is a correction of an isotropic
+    // march (Hillaire 2020's approximation, src/neural/mlp_hd.h's
+    // analytic_multiple) by a factor within e^±2: ln ψ per channel, the sky's
+    // mean radiance around a point, as a polynomial of degrees 2 in altitude
+    // and 6 in the sun's cosine (3 × 21 coefficients, r then g then b), over
+    // sun cosines from multiple_psi_mu_min to 1. Empty: log-encoded as above
+    // (multiple_max is then what decodes it).
+    std::vector<double> multiple_psi;
+    double multiple_psi_mu_min = -0.5;
+    bool multiple_marched() const { return !multiple_psi.empty(); }
     // An atmosphere family (residual outputs of single scattering): the
     // amount of one scattering component, the aerosol, is a fifth input,
     // chosen at run time (NeuralSky::aerosol) as a multiple of the
@@ -289,6 +299,15 @@ struct NeuralTrainOptions {
     // held-out ones) is drawn where the sky is hard instead of uniformly: a
     // third each near the horizon, the sun's aureole and the terminator.
     double hard_share = 0.0;
+    // This share of the training samples (after the hard ones) is drawn as a
+    // flight's (draw_flight_samples: altitude uniform to 60 km, the sun down to
+    // −20°), whose high, dim twilight the uniform samples barely reach. −1:
+    // automatic, 0.3 with multiple scattering (where it pays: docs/neural.md)
+    // and 0 for single scattering (where it does not).
+    double flight_share = -1.0;
+    // Residual outputs with multiple scattering: the term as a correction of
+    // an isotropic march (NeuralEncoding::multiple_psi), or, false, log-encoded.
+    bool multiple_march = true;
 };
 
 // One point of the learning curve: after Adam epoch `epoch` (phase "adam") or

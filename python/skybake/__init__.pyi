@@ -212,6 +212,8 @@ def train_sky(
     device: str = "cpu",
     aerosol_range: Optional[tuple[float, float]] = None,
     hard_share: float = 0.0,
+    flight_share: Optional[float] = None,
+    multiple_term: str = "march",
     progress: Progress = None,
 ) -> NeuralSky: ...
 

@@ -248,7 +248,7 @@ void bind_sky(py::module_& m) {
            std::optional<std::string> outputs, std::size_t samples, int adam_epochs, int lm_iterations,
            std::uint64_t seed, const std::string& brightness, const std::string& table_rule, int steps,
            const std::string& device, std::optional<std::pair<double, double>> aerosol_range, double hard_share,
-           py::object progress) {
+           std::optional<double> flight_share, const std::string& multiple_term, py::object progress) {
             atmosphere.table_rule = parse_table_rule(table_rule, "table_rule");
             atmosphere.validate();
             if (steps < 1 || steps > 4096)
@@ -266,6 +266,14 @@ void bind_sky(py::module_& m) {
             o.outputs = outputs ? parse_output_encoding(*outputs, "outputs") : default_output_encoding(atmosphere);
             o.device = parse_device(device);
             o.hard_share = hard_share;
+            if (flight_share) {
+                if (!(*flight_share >= 0.0 && *flight_share <= 1.0))
+                    throw Error("must be in [0, 1]", "flight_share");
+                o.flight_share = *flight_share;
+            }
+            if (multiple_term != "march" && multiple_term != "log")
+                throw Error("must be 'march' or 'log'", "multiple_term");
+            o.multiple_march = multiple_term == "march";
             if (aerosol_range) {
                 o.family_component = "mie";
                 o.aerosol_min = aerosol_range->first;
@@ -289,13 +297,16 @@ void bind_sky(py::module_& m) {
         py::arg("adam_epochs") = 60, py::arg("lm_iterations") = 20, py::arg("seed") = 1,
         py::arg("brightness") = "log", py::arg("table_rule") = "refined", py::arg("steps") = kTrainingTargetSteps,
         py::arg("device") = "cpu", py::arg("aerosol_range") = py::none(), py::arg("hard_share") = 0.0,
-        py::arg("progress") = py::none(),
+        py::arg("flight_share") = py::none(), py::arg("multiple_term") = "march", py::arg("progress") = py::none(),
         "Trains a network on the table path of `atmosphere` (Adam, then Levenberg–Marquardt), as "
         "`skybake sky train`: by default the best small network (shared:16x12, horizon inputs, residual "
-        "outputs; radiance outputs with multiple scattering), targets from the refined 512 x 256 tables with 64 "
+        "outputs, with multiple scattering too), targets from the refined 512 x 256 tables with 64 "
         "steps. aerosol_range=(min, max): one network for the family of atmospheres whose 'mie' amount is that "
         "multiple of the atmosphere's, chosen at run time (NeuralSky.aerosol). hard_share: the share of training "
-        "samples drawn near the horizon, the sun and the terminator (importance sampling; 0 by default). The seed's network: topology='paper', inputs='seed', outputs='radiance', brightness='linear' "
+        "samples drawn near the horizon, the sun and the terminator (importance sampling; 0 by default). "
+        "flight_share: the share drawn as a flight's, altitude uniform to 60 km and the sun down to -20 degrees "
+        "(None: 0.3 with multiple scattering, else 0). multiple_term: with multiple scattering, 'march' (a "
+        "correction of an isotropic march) or 'log' (log-encoded). The seed's network: topology='paper', inputs='seed', outputs='radiance', brightness='linear' "
         "(and table_rule='as-published', steps=16 for its targets). Deterministic for a seed. "
         "topology: 'paper' (324 weights), 'independent:16x16', 'shared:64x64', ...");
 }

@@ -62,6 +62,27 @@ inline NeuralSky with_encoding(NeuralSky net, InputEncoding inputs, OutputEncodi
     return with_random_weights(std::move(net), seed);
 }
 
+// The same network with its multiple-scattering term marched
+// (NeuralEncoding::multiple_psi): ln ψ of a realistic shape, from about e^-10
+// at the lowest sun to e^-4 at noon and a little brighter high up, different
+// per channel. Needs residual outputs with multiple scattering.
+inline NeuralSky with_marched_multiple(NeuralSky net) {
+    net.encoding.multiple_psi.assign(std::size_t(3 * neural::kPsiCoefficients), 0.0);
+    net.encoding.multiple_psi_mu_min = -0.5;
+    for (int c = 0; c < 3; ++c) {
+        double* a = net.encoding.multiple_psi.data() + c * neural::kPsiCoefficients;
+        const int row = neural::kPsiSunDegree + 1; // a[i * row + j]: x^i y^j
+        a[0] = std::log(0.02 * (1.0 + 0.3 * c));
+        a[1] = 4.0 - 0.2 * c;
+        a[2] = -2.0;
+        a[3] = 0.3;
+        a[row] = 0.2;
+        a[row + 1] = -0.1 * c;
+        a[2 * row] = -0.05;
+    }
+    return net;
+}
+
 // The same network as one of an aerosol family (its "mie" amount from lo to
 // hi, a fifth input), evaluated at `aerosol`, with new pseudo-random weights.
 // Needs residual outputs of single scattering.

@@ -85,7 +85,8 @@ namespace {
 // scale height; then with residual outputs R0, Rtop − R0, the scale height,
 // per exponential component its scale height and extinction (r, g, b), per
 // term its scattering (r, g, b), per term g, and with multiple scattering the
-// largest multiply scattered light (r, g, b); else per phase term g and
+// largest multiply scattered light (r, g, b), or for a marched term ψ's lowest
+// sun cosine and its 3 × kPsiCoefficients coefficients; else per phase term g and
 // max S (r, g, b). An aerosol family ends the list with its input's a and b
 // and the run-time aerosol amount. This is the order the exporter reads them in.
 std::vector<float> encoding_constants(const NeuralSky& net) {
@@ -103,8 +104,13 @@ std::vector<float> encoding_constants(const NeuralSky& net) {
             c.insert(c.end(), {m.term_beta[k][0], m.term_beta[k][1], m.term_beta[k][2]});
         for (int k = 0; k < m.terms; ++k)
             c.push_back(m.term_g[k]);
-        if (m.multiple)
+        if (m.multiple && m.multiple_march) { // ψ's sun range and its polynomial, r then g then b
+            c.push_back(m.psi_mu_min);
+            for (int ch = 0; ch < 3; ++ch)
+                c.insert(c.end(), m.psi[ch], m.psi[ch] + kPsiCoefficients);
+        } else if (m.multiple) {
             c.insert(c.end(), {m.multiple_max[0], m.multiple_max[1], m.multiple_max[2]});
+        }
         if (m.family)
             c.insert(c.end(), {m.family_a, m.family_b, m.aerosol});
         return c;
@@ -300,9 +306,16 @@ QFLOAT NAME_segment(FLOAT R0, FLOAT H, FLOAT ha, FLOAT ca, FLOAT rho_a, FLOAT hb
     return t;
 }
 
+// The analytic march's constants as the function reads them (literals, or
+// values of the uniform block).
+struct MarchConstants {
+    std::string R0, top, scale;
+    std::vector<std::string> H, be, bs; // per component; per component and channel; per term and channel
+};
+
 // mlp_hd.h's analytic_terms, operation for operation, into A<k>r, A<k>g, A<k>b.
-void emit_analytic_terms(std::ostringstream& o, const std::string& name, const MlpHD& m, const Dialect& d,
-                         const Constant& constant) {
+MarchConstants emit_analytic_terms(std::ostringstream& o, const std::string& name, const MlpHD& m, const Dialect& d,
+                                   const Constant& constant) {
     const std::string R0 = constant(m.R0), top = constant(m.Rtop - m.R0), scale = constant(m.scale_height);
     std::vector<std::string> H(std::size_t(m.ext_count)), be(std::size_t(3 * m.ext_count)),
         bs(std::size_t(3 * m.terms));
@@ -331,6 +344,15 @@ void emit_analytic_terms(std::ostringstream& o, const std::string& name, const M
                   fmt::format("-{} * (density > {} ? {} * a_u * ({} + a_u2 * ({} + a_u2 * {})) : {}(density))", scale,
                               lit(0.97f, d), two, one, lit(0.333333343f, d), lit(0.2f, d), log_),
                   R0, top, d);
+    // an observer above the top whose ray misses the atmosphere sees no air (misses_atmosphere)
+    o << "    bool a_miss;\n";
+    o << "    {\n";
+    o << fmt::format("        float hr = -{} * (density > {} ? {} * a_u * ({} + a_u2 * ({} + a_u2 * {})) : {}(density));\n",
+                     scale, lit(0.97f, d), two, one, lit(0.333333343f, d), lit(0.2f, d), log_);
+    o << fmt::format("        float r = {0} + hr, rt = {0} + {1};\n", R0, top);
+    o << fmt::format("        float s2 = ({0} - cos_view_zenith) * ({0} + cos_view_zenith);\n", one);
+    o << fmt::format("        a_miss = hr > {} && (cos_view_zenith >= {} || r * r * s2 >= rt * rt);\n", top, zero);
+    o << "    }\n";
     o << "    float a_d;\n";
     o << fmt::format("    if (cos_view_zenith < {} && a_arc >= a_rho) {{\n", zero);
     o << "        float disc = (a_arc - a_rho) * (a_arc + a_rho);\n";
@@ -369,6 +391,7 @@ void emit_analytic_terms(std::ostringstream& o, const std::string& name, const M
     o << "        } else {\n            a_sh = false;\n        }\n";
     o << "    }\n";
     o << "    a_sh = a_sh && a_lo < a_hi;\n";
+    o << "    if (a_miss) {\n        a_d = " << zero << ";\n        a_sh = false;\n    }\n";
     o << "    // the march over the lit parts\n";
     o << fmt::format("    float a_rho2 = a_rho * a_rho, a_2rmu = {} * a_r * cos_view_zenith;\n", two);
     // The view's depth: a trapezoid sum from the previous point, or (a family) Chapman integrals from the observer.
@@ -465,11 +488,85 @@ void emit_analytic_terms(std::ostringstream& o, const std::string& name, const M
         o << "        }\n";
     }
     o << "    }\n";
+    return {R0, top, scale, H, be, bs};
+}
+
+// mlp_hd.h's analytic_multiple (multiple_steps and psi_log), operation for
+// operation, into M_r, M_g, M_b; ψ's constants from `constant`.
+void emit_analytic_multiple(std::ostringstream& o, const MlpHD& m, const Dialect& d, const MarchConstants& mc,
+                            const Constant& constant) {
+    const std::string mu_min = constant(m.psi_mu_min);
+    std::vector<std::string> a(std::size_t(3 * kPsiCoefficients));
+    for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < kPsiCoefficients; ++i)
+            a[std::size_t(c * kPsiCoefficients + i)] = constant(m.psi[c][i]);
+    const std::string zero = lit(0.0f, d), one = lit(1.0f, d), two = lit(2.0f, d), half = lit(0.5f, d);
+    const std::string sqrt_ = d.shader ? "sqrt" : "sqrtf", log_ = d.shader ? "log" : "logf", exp_ = d.exp;
+    const char* ch = "rgb";
+    o << "    // the light scattered more than once: an isotropic march of the sky's mean radiance psi (skybake's\n"
+         "    // analytic_multiple), which the network corrects\n";
+    o << fmt::format("    float M_r = {0}, M_g = {0}, M_b = {0};\n", zero);
+    o << "    {\n";
+    o << "        if (!a_miss) {\n";
+    o << fmt::format("        float dt = a_d * {};\n", lit(1.0f / float(kMultipleSteps), d));
+    for (int e = 0; e < m.ext_count; ++e)
+        o << fmt::format("        float mp{} = {}(-a_h / {});\n", e, exp_, mc.H[std::size_t(e)]);
+    o << fmt::format("        float mt_r = {0}, mt_g = {0}, mt_b = {0};\n", zero);
+    o << fmt::format("        float fm = {}, fe = {};\n", half, one);
+    o << fmt::format("        for (int k = 0; k < {}; ++k) {{\n", kMultipleSteps);
+    const char* which[] = {"m", "e"};
+    for (int j = 0; j < 2; ++j) {
+        o << fmt::format("            float t{0} = f{0} * dt;\n", which[j]);
+        o << fmt::format("            float q{0} = a_rho2 + t{0} * (a_2rmu + t{0});\n", which[j]);
+        o << fmt::format("            q{0} = q{0} > {1} ? q{0} : {1};\n", which[j], zero);
+        o << fmt::format("            float h{0} = q{0} / ({1}(q{0} + {2} * {2}) + {2});\n", which[j], sqrt_, mc.R0);
+    }
+    o << fmt::format("            float mus = (a_r * cos_sun_zenith + tm * cos_view_sun) / ({} + hm);\n", mc.R0);
+    o << "            fm += " << one << ";\n            fe += " << one << ";\n";
+    for (int e = 0; e < m.ext_count; ++e) {
+        o << fmt::format("            float mid{0} = {1}(-hm / {2});\n", e, exp_, mc.H[std::size_t(e)]);
+        o << fmt::format("            float end{0} = {1}(-he / {2});\n", e, exp_, mc.H[std::size_t(e)]);
+    }
+    // psi_log's arguments, clamped.
+    o << fmt::format("            float px = {} * hm / {} - {};\n", two, mc.top, one);
+    o << fmt::format("            float py = ({0} * mus - {1} - {2}) / ({1} - {2});\n", two, one, mu_min);
+    o << fmt::format("            px = px > -{0} ? (px < {0} ? px : {0}) : -{0};\n", one);
+    o << fmt::format("            py = py > -{0} ? (py < {0} ? py : {0}) : -{0};\n", one);
+    for (int c = 0; c < 3; ++c) {
+        o << "            {\n";
+        o << fmt::format("                float dtau = {0}, sca = {0};\n", zero);
+        for (int e = 0; e < m.ext_count; ++e)
+            o << fmt::format("                dtau += {} * {} * (mp{} + end{}) * dt;\n", mc.be[std::size_t(3 * e + c)],
+                             half, e, e);
+        for (int k = 0; k < m.terms; ++k)
+            o << fmt::format("                sca += {} * mid{};\n", mc.bs[std::size_t(3 * k + c)], m.term_ext[k]);
+        o << fmt::format("                float f = dtau > {0} ? ({1} - {2}(-dtau)) / dtau : {1} - dtau * ({3} - dtau * "
+                         "({4} - dtau * {5}));\n",
+                         lit(0.1f, d), one, exp_, half, lit(0.166666672f, d), lit(0.0416666679f, d));
+        o << fmt::format("                float w = {}(-mt_{}) * sca * dt * f;\n", exp_, ch[c]);
+        o << fmt::format("                mt_{} += dtau;\n", ch[c]);
+        o << fmt::format("                float acc = {};\n", zero);
+        for (int i = kPsiAltitudeDegree; i >= 0; --i) {
+            o << fmt::format("                {{ float row = {};\n", zero);
+            for (int j = kPsiSunDegree; j >= 0; --j)
+                o << fmt::format("                  row = row * py + {};\n",
+                                 a[std::size_t(c * kPsiCoefficients + i * (kPsiSunDegree + 1) + j)]);
+            o << "                  acc = acc * px + row; }\n";
+        }
+        o << fmt::format("                M_{} += w * {}(acc);\n", ch[c], exp_);
+        o << "            }\n";
+    }
+    for (int e = 0; e < m.ext_count; ++e)
+        o << fmt::format("            mp{0} = end{0};\n", e);
+    o << "        }\n";
+    o << "        }\n";
+    o << "    }\n";
 }
 
 // I = Σ_k P_k(cos b0) A_k exp(R (x − 0.5)/0.45) per channel.
 void emit_residual_decoding(std::ostringstream& o, const NeuralSky& net, const MlpHD& m, const Dialect& d,
-                            const std::vector<std::string>& outputs, const Constant& constant) {
+                            const std::vector<std::string>& outputs, const MarchConstants& mc,
+                            const Constant& constant) {
     const std::string zero = lit(0.0f, d), half = lit(0.5f, d);
     const std::string scale = lit(kResidualRange / (0.5f * kEncodeScale), d);
     o << "    // decoding: per phase term, the exact phase function times A as the network corrects it\n";
@@ -483,7 +580,12 @@ void emit_residual_decoding(std::ostringstream& o, const NeuralSky& net, const M
                              outputs[std::size_t(3 * k + c)], half);
         o << "    }\n";
     }
-    if (m.multiple) {
+    if (m.multiple && m.multiple_march) {
+        emit_analytic_multiple(o, m, d, mc, constant);
+        for (int c = 0; c < 3; ++c)
+            o << fmt::format("    {} += M_{} * {}({} * ({} - {}));\n", acc[c], ch[c], d.exp, scale,
+                             outputs[std::size_t(3 * m.terms + c)], half);
+    } else if (m.multiple) {
         const std::string inv = lit(1.0f / kEncodeScale, d), off = lit(kEncodeOffset, d), one = lit(1.0f, d);
         o << "    { // the light scattered more than once, log-encoded per channel\n";
         for (int c = 0; c < 3; ++c) {
@@ -663,8 +765,8 @@ std::string export_neural_sky(const NeuralSky& net, ExportLanguage lang, const S
     }
     const std::string inv = lit(1.0f / kEncodeScale, d), off = lit(kEncodeOffset, d), zero = lit(0.0f, d);
     if (m.output_kind == kOutputsResidual) {
-        emit_analytic_terms(o, name, m, d, constant);
-        emit_residual_decoding(o, net, m, d, outputs, constant);
+        const MarchConstants mc = emit_analytic_terms(o, name, m, d, constant);
+        emit_residual_decoding(o, net, m, d, outputs, mc, constant);
         o << "}\n";
         return o.str();
     }

@@ -59,6 +59,7 @@ struct Encoding {
     OutputEncoding outputs;
     const char* name;
     bool multiple = false; // residual outputs of a sky with multiple scattering
+    bool march = false;    // its term a correction of the isotropic march
 };
 constexpr Encoding kNewEncodings[] = {
     {InputEncoding::Horizon, OutputEncoding::Radiance, "horizon/radiance"},
@@ -67,7 +68,13 @@ constexpr Encoding kNewEncodings[] = {
     {InputEncoding::Seed, OutputEncoding::Residual, "seed/residual"},
     {InputEncoding::Horizon, OutputEncoding::Residual, "horizon/residual"},
     {InputEncoding::Horizon, OutputEncoding::Residual, "horizon/residual, multiple scattering", true},
+    {InputEncoding::Horizon, OutputEncoding::Residual, "horizon/residual, multiple scattering marched", true, true},
 };
+
+NeuralSky encoded(NeuralSky net, const Encoding& e) {
+    net = neural_test::with_encoding(std::move(net), e.inputs, e.outputs, 7, e.multiple);
+    return e.march ? neural_test::with_marched_multiple(std::move(net)) : net;
+}
 
 // Every network the tests below export: two topologies, both brightness codes
 // of the seed's encoding, and each new encoding.
@@ -77,9 +84,7 @@ std::vector<std::pair<std::string, NeuralSky>> export_cases() {
         cases.emplace_back(fmt::format("{} log", top), make_net(top, BrightnessEncoding::Log));
         cases.emplace_back(fmt::format("{} linear", top), make_net(top, BrightnessEncoding::Linear));
         for (const Encoding& e : kNewEncodings)
-            cases.emplace_back(fmt::format("{} {}", top, e.name),
-                               neural_test::with_encoding(make_net(top, BrightnessEncoding::Log), e.inputs, e.outputs, 7,
-                                                          e.multiple));
+            cases.emplace_back(fmt::format("{} {}", top, e.name), encoded(make_net(top, BrightnessEncoding::Log), e));
         // An aerosol family: a fifth argument, and the march's aerosol scaled by it.
         cases.emplace_back(
             fmt::format("{} horizon/residual, aerosol family at 3.7", top),
@@ -193,8 +198,7 @@ TEST(NeuralExport, GlslCompilesInVertexAndFragmentShaders) {
                                                         {"independent:16x16",
                                                          make_net("independent:16x16", BrightnessEncoding::Log)}};
     for (const Encoding& e : kNewEncodings)
-        nets.emplace_back(e.name, neural_test::with_encoding(make_net("paper", BrightnessEncoding::Log), e.inputs,
-                                                             e.outputs, 3, e.multiple));
+        nets.emplace_back(e.name, encoded(make_net("paper", BrightnessEncoding::Log), e));
     nets.emplace_back("aerosol family",
                       neural_test::with_family(neural_test::with_encoding(make_net("paper", BrightnessEncoding::Log),
                                                                           InputEncoding::Horizon,

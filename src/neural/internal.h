@@ -120,7 +120,8 @@ std::vector<float> draw_aerosol(const NeuralEncoding& encoding, std::size_t n, s
 int family_component_index(const NeuralEncoding& encoding, const Atmosphere& atmosphere);
 // n samples (seed) of model's table path with their encoded targets.
 TrainingData make_training_data(const SkyModel& model, const NeuralEncoding& encoding, std::size_t n,
-                                std::uint64_t seed, Device device, double hard_share = 0.0);
+                                std::uint64_t seed, Device device, double hard_share = 0.0,
+                                double flight_share = 0.0);
 // n samples where the sky is hard for a network (NeuralTrainOptions::hard_share),
 // a third each: views within sin 2° (in cosine) of the geometric horizon, within 15° of the sun,
 // and suns from −15° to 5°; densities uniform in (0, 1] as draw_sky_samples.
@@ -158,6 +159,15 @@ Atmosphere scaled_atmosphere(const NeuralEncoding& family, const Atmosphere& atm
 // m; `aerosol`, when not empty, holds each sample's aerosol amount (a family).
 MatF samples_to_matrix(const MlpHD& m, std::span<const SkySample> samples, std::span<const float> aerosol = {});
 // analytic_terms (3 per term × n) of the samples.
+// NeuralTrainOptions::flight_share, with its automatic value resolved.
+constexpr double kMultipleFlightShare = 0.3;
+double effective_flight_share(const NeuralTrainOptions& options, const Atmosphere& atmosphere);
+
+// ln ψ's coefficients (NeuralEncoding::multiple_psi) for the model's sky:
+// the polynomial of psi_log fitted by least squares to the log of the sky's
+// mean radiance over the sphere, at altitudes from the ground to the top and
+// sun cosines from mu_s_min to 1.
+std::vector<double> fit_multiple_psi(const SkyModel& model, double mu_s_min, Device device);
 MatF analytic_matrix(const MlpHD& m, std::span<const SkySample> samples, std::span<const float> aerosol = {});
 // evaluate_neural_sky with each sample's own aerosol amount (empty: net.aerosol).
 void evaluate_neural_sky_at(const NeuralSky& net, std::span<const SkySample> samples, std::span<const float> aerosol,

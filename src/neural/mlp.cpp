@@ -100,6 +100,13 @@ void set_encoding_hd(const NeuralEncoding& e, const Atmosphere& atmosphere, MlpH
     m.multiple = e.multiple ? 1 : 0;
     for (int c = 0; c < 3; ++c)
         m.multiple_max[c] = float(e.multiple_max[c]);
+    m.multiple_march = e.multiple && e.multiple_marched() ? 1 : 0;
+    if (m.multiple_march) {
+        m.psi_mu_min = float(e.multiple_psi_mu_min);
+        for (int c = 0; c < 3; ++c)
+            for (int i = 0; i < kPsiCoefficients; ++i)
+                m.psi[c][i] = float(e.multiple_psi[std::size_t(c * kPsiCoefficients + i)]);
+    }
     // The analytic march's atmosphere (check_residual_atmosphere has checked it fits).
     m.ext_count = 0;
     for (const AtmosphereComponent& c : atmosphere.components)
@@ -335,7 +342,7 @@ void encode_residual_targets(std::span<const glm::vec3> split, std::size_t compo
 }
 
 MatF analytic_matrix(const MlpHD& m, std::span<const SkySample> samples, std::span<const float> aerosol) {
-    MatF a(3 * m.terms, Eigen::Index(samples.size()));
+    MatF a(3 * m.terms + (m.multiple && m.multiple_march ? 3 : 0), Eigen::Index(samples.size()));
     parallel_for(samples.size(), 4096, [&](std::size_t b, std::size_t e) {
         float base[kMaxOutputs];
         MlpHD at = m;
@@ -343,8 +350,8 @@ MatF analytic_matrix(const MlpHD& m, std::span<const SkySample> samples, std::sp
             const SkySample& s = samples[i];
             if (!aerosol.empty())
                 at.aerosol = aerosol[i];
-            analytic_terms(at, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, base);
-            for (int k = 0; k < 3 * m.terms; ++k)
+            analytic_base(at, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, base);
+            for (int k = 0; k < int(a.rows()); ++k)
                 a(k, Eigen::Index(i)) = base[k];
         }
     });
@@ -428,7 +435,7 @@ void neural::evaluate_neural_sky_at(const NeuralSky& net, std::span<const SkySam
                     hd.aerosol = aerosol[i];
                 assert(is_valid_sky_sample(s, 1e-4));
                 if (hd.output_kind == kOutputsResidual)
-                    analytic_terms(hd, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, base);
+                    analytic_base(hd, s.cos_view_zenith, s.cos_view_sun, s.cos_sun_zenith, s.density, base);
                 out[i] = decode_sky(hd, enc.col(Eigen::Index(i - lo)).data(), s.cos_view_sun, base);
             }
         }

@@ -45,6 +45,12 @@ constexpr float kResidualRange = 2.0f;
 // Their multiple-scattering term's log range: 12 decades (nats), down to the
 // sky of a sun 20° below the horizon (which the sky's own 6 would cut).
 constexpr float kMultipleLogRange = 27.6310211f;
+// Or, as a correction of an isotropic march (analytic_multiple), within the
+// terms' e^±kResidualRange: the march's steps over the whole view ray, and the
+// degrees of ln ψ's polynomial in altitude and in the sun's cosine.
+constexpr int kMultipleSteps = 4;
+constexpr int kPsiAltitudeDegree = 2, kPsiSunDegree = 6;
+constexpr int kPsiCoefficients = (kPsiAltitudeDegree + 1) * (kPsiSunDegree + 1);
 
 struct MlpHD {
     const float* weights = nullptr; // subnets * subnet_params floats
@@ -77,6 +83,12 @@ struct MlpHD {
     // and with multiple scattering, the log-encoded term after the others.
     int multiple = 0;
     float multiple_max[3] = {};
+    // The term as a correction of an isotropic march (analytic_multiple):
+    // ln ψ per channel, a polynomial in altitude and the sun's cosine
+    // (psi_log); multiple_march 0: the term log-encoded below multiple_max.
+    int multiple_march = 0;
+    float psi_mu_min = -0.5f;
+    float psi[3][kPsiCoefficients] = {};
     // An aerosol family (residual outputs): the network's fifth input is
     // family_a ln(aerosol) + family_b (−1 to 1 over the trained range), and the
     // march scales the extinction of exponential component family_ext and the
@@ -307,6 +319,32 @@ SKYBAKE_HD_INLINE float chapman_segment(float R0, float H, float ha, float ca, f
     return 2.0f * H * expf(-h0 / H) * chapman_function(h0, R0, H, 0.0f) - fa - fb;
 }
 
+// view_ray with the altitude from log_density and the ray's length without
+// view_ray's cancellation (a short ray to the ground, or up from near the
+// top): the root's other form.
+SKYBAKE_HD_INLINE ViewRayHD view_ray_precise(const MlpHD& m, float cos_view_zenith, float density) {
+    ViewRayHD v = view_ray_at(m, cos_view_zenith, -m.scale_height * log_density(density));
+    const float rc = v.r * cos_view_zenith, arc = fabsf(rc), top = m.Rtop - m.R0;
+    if (v.ground) {
+        const float disc = (arc - v.rho) * (arc + v.rho);
+        v.d = v.rho * v.rho / (arc + sqrtf(disc > 0.0f ? disc : 0.0f));
+    } else if (rc > 0.0f) {
+        const float k = (top - v.h) * (2.0f * m.R0 + top + v.h); // Rtop² − r²
+        const float disc = rc * rc + k;
+        v.d = k / (rc + sqrtf(disc > 0.0f ? disc : 0.0f));
+    }
+    return v;
+}
+
+// True for an observer above the top (the inputs see it at the top) whose
+// ray misses the atmosphere: it sees no air.
+SKYBAKE_HD_INLINE bool misses_atmosphere(const MlpHD& m, float cos_view_zenith, float density) {
+    const float top = m.Rtop - m.R0, hr = -m.scale_height * log_density(density);
+    const float r = m.R0 + hr, rt = m.R0 + top;
+    const float s2 = (1.0f - cos_view_zenith) * (1.0f + cos_view_zenith);
+    return hr > top && (cos_view_zenith >= 0.0f || r * r * s2 >= rt * rt);
+}
+
 // The analytic single scattering A per phase term and channel (1/sr per unit
 // sun irradiance, without the phase function) into base[3 k + c]. In each lit
 // part the midpoint sum of each component's density is scaled to its
@@ -317,19 +355,9 @@ SKYBAKE_HD_INLINE void analytic_terms(const MlpHD& m, float cos_view_zenith, flo
                                       float density, float* base) {
     for (int i = 0; i < 3 * m.terms; ++i)
         base[i] = 0.0f;
-    ViewRayHD v = view_ray_at(m, cos_view_zenith, -m.scale_height * log_density(density));
-    {   // The ray's length without view_ray's cancellation (a short ray to the
-        // ground, or up from near the top): the root's other form.
-        const float rc = v.r * cos_view_zenith, arc = fabsf(rc), top = m.Rtop - m.R0;
-        if (v.ground) {
-            const float disc = (arc - v.rho) * (arc + v.rho);
-            v.d = v.rho * v.rho / (arc + sqrtf(disc > 0.0f ? disc : 0.0f));
-        } else if (rc > 0.0f) {
-            const float k = (top - v.h) * (2.0f * m.R0 + top + v.h); // Rtop² − r²
-            const float disc = rc * rc + k;
-            v.d = k / (rc + sqrtf(disc > 0.0f ? disc : 0.0f));
-        }
-    }
+    if (misses_atmosphere(m, cos_view_zenith, density))
+        return;
+    const ViewRayHD v = view_ray_precise(m, cos_view_zenith, density);
     // The family's aerosol amount scales its component's coefficients.
     float ext_beta[kMaxTerms][3], term_beta[kMaxTerms][3];
     for (int e = 0; e < m.ext_count; ++e)
@@ -419,6 +447,105 @@ SKYBAKE_HD_INLINE void analytic_terms(const MlpHD& m, float cos_view_zenith, flo
     }
 }
 
+// [SECTION] Residual outputs' multiple-scattering term: an isotropic march
+//
+// Hillaire 2020's approximation of the light scattered more than once: every
+// point of the view ray scatters towards the observer, isotropically, the
+// mean radiance ψ of the sky around it, which depends only on its altitude
+// and the sun's cosine there. Here ψ is the mean of the model's own sky (single
+// plus multiple scattering) over the sphere, fitted at training time as ln ψ
+// = Σ a_ij x^i y^j per channel, x = 2h/(Rtop − R0) − 1, y the sun's cosine
+// mapped from [psi_mu_min, 1] onto [−1, 1], both clamped (psi_log). The march
+// takes kMultipleSteps midpoints over the whole ray (lit or not), each
+// adding ψ σs dt e^(−τ) (1 − e^(−Δτ))/Δτ with the step's view depth Δτ a
+// trapezoid: exact for a step of constant coefficients however thick. The
+// network's outputs x are log ratios to it: S = M exp(R (x − 0.5)/0.45),
+// R = kResidualRange, as for the terms.
+SKYBAKE_HD_INLINE float psi_log(const MlpHD& m, int c, float h, float mu_s) {
+    float x = 2.0f * h / (m.Rtop - m.R0) - 1.0f;
+    float y = (2.0f * mu_s - 1.0f - m.psi_mu_min) / (1.0f - m.psi_mu_min);
+    x = x > -1.0f ? (x < 1.0f ? x : 1.0f) : -1.0f;
+    y = y > -1.0f ? (y < 1.0f ? y : 1.0f) : -1.0f;
+    float acc = 0.0f;
+    for (int i = kPsiAltitudeDegree; i >= 0; --i) {
+        float row = 0.0f;
+        for (int j = kPsiSunDegree; j >= 0; --j)
+            row = row * y + m.psi[c][i * (kPsiSunDegree + 1) + j];
+        acc = acc * x + row;
+    }
+    return acc;
+}
+
+// The march's steps: each step k's weight w[k][c] = σs dt e^(−τ) (1 −
+// e^(−Δτ))/Δτ per channel, and its midpoint's altitude h[k] and sun cosine
+// mu_s[k]. False (and no steps) where the ray sees no air.
+SKYBAKE_HD_INLINE bool multiple_steps(const MlpHD& m, float cos_view_zenith, float cos_view_sun, float cos_sun_zenith,
+                                      float density, float w[kMultipleSteps][3], float h[kMultipleSteps],
+                                      float mu_s[kMultipleSteps]) {
+    if (misses_atmosphere(m, cos_view_zenith, density))
+        return false;
+    const ViewRayHD v = view_ray_precise(m, cos_view_zenith, density);
+    const float rho2 = v.rho * v.rho, two_r_mu = 2.0f * v.r * cos_view_zenith;
+    const float dt = v.d * (1.0f / float(kMultipleSteps));
+    float prev[kMaxTerms], tau[3] = {0.0f, 0.0f, 0.0f};
+    for (int e = 0; e < m.ext_count; ++e)
+        prev[e] = expf(-v.h / m.ext_height[e]);
+    for (int k = 0; k < kMultipleSteps; ++k) {
+        float hp[2];
+        for (int j = 0; j < 2; ++j) { // the step's midpoint, then its end
+            const float t = (float(k) + (j == 0 ? 0.5f : 1.0f)) * dt;
+            float q = rho2 + t * (two_r_mu + t); // |p|² − R0²
+            q = q > 0.0f ? q : 0.0f;
+            hp[j] = q / (sqrtf(q + m.R0 * m.R0) + m.R0);
+        }
+        h[k] = hp[0];
+        mu_s[k] = (v.r * cos_sun_zenith + (float(k) + 0.5f) * dt * cos_view_sun) / (m.R0 + hp[0]);
+        float mid[kMaxTerms], end[kMaxTerms];
+        for (int e = 0; e < m.ext_count; ++e) {
+            mid[e] = expf(-hp[0] / m.ext_height[e]);
+            end[e] = expf(-hp[1] / m.ext_height[e]);
+        }
+        for (int c = 0; c < 3; ++c) {
+            float sca = 0.0f, dtau = 0.0f;
+            for (int e = 0; e < m.ext_count; ++e)
+                dtau += m.ext_beta[e][c] * 0.5f * (prev[e] + end[e]) * dt;
+            for (int k2 = 0; k2 < m.terms; ++k2)
+                sca += m.term_beta[k2][c] * mid[m.term_ext[k2]];
+            // (1 − e^(−Δτ))/Δτ, by its series where the difference would cancel
+            // (shaders' exp is a few ulp off; 1/Δτ would magnify that).
+            const float f = dtau > 0.1f ? (1.0f - expf(-dtau)) / dtau
+                                        : 1.0f - dtau * (0.5f - dtau * (0.166666672f - dtau * 0.0416666679f));
+            w[k][c] = expf(-tau[c]) * sca * dt * f;
+            tau[c] += dtau;
+        }
+        for (int e = 0; e < m.ext_count; ++e)
+            prev[e] = end[e];
+    }
+    return true;
+}
+
+// The march M = Σ_k w[k] ψ(h[k], mu_s[k]) per channel (1/sr per unit sun
+// irradiance) into out[0..2].
+SKYBAKE_HD_INLINE void analytic_multiple(const MlpHD& m, float cos_view_zenith, float cos_view_sun,
+                                         float cos_sun_zenith, float density, float* out) {
+    float w[kMultipleSteps][3], h[kMultipleSteps], mu_s[kMultipleSteps];
+    out[0] = out[1] = out[2] = 0.0f;
+    if (!multiple_steps(m, cos_view_zenith, cos_view_sun, cos_sun_zenith, density, w, h, mu_s))
+        return;
+    for (int k = 0; k < kMultipleSteps; ++k)
+        for (int c = 0; c < 3; ++c)
+            out[c] += w[k][c] * expf(psi_log(m, c, h[k], mu_s[k]));
+}
+
+// The residual outputs' analytic parts: analytic_terms into base[0, 3 terms),
+// and for a multiple-scattering term marched, analytic_multiple after them.
+SKYBAKE_HD_INLINE void analytic_base(const MlpHD& m, float cos_view_zenith, float cos_view_sun, float cos_sun_zenith,
+                                     float density, float* base) {
+    analytic_terms(m, cos_view_zenith, cos_view_sun, cos_sun_zenith, density, base);
+    if (m.multiple && m.multiple_march)
+        analytic_multiple(m, cos_view_zenith, cos_view_sun, cos_sun_zenith, density, base + 3 * m.terms);
+}
+
 // Encoded value -> [0, ...): (x − 0.05)/0.9, values below 0.05 are 0.
 SKYBAKE_HD_INLINE float decode_unit(float x) {
     const float v = (x - kEncodeOffset) * (1.0f / kEncodeScale);
@@ -447,7 +574,14 @@ SKYBAKE_HD_INLINE glm::vec3 decode_sky(const MlpHD& m, const float* enc, float c
             c.y += p * base[3 * k + 1] * expf(scale * (enc[3 * k + 1] - 0.5f));
             c.z += p * base[3 * k + 2] * expf(scale * (enc[3 * k + 2] - 0.5f));
         }
-        if (m.multiple) { // the light scattered more than once, log-encoded
+        if (m.multiple && m.multiple_march) { // the light scattered more than once, a correction of its march
+            const float* x = enc + 3 * m.terms;
+            const float* a = base + 3 * m.terms;
+            const float ms = kResidualRange / (0.5f * kEncodeScale);
+            c.x += a[0] * expf(ms * (x[0] - 0.5f));
+            c.y += a[1] * expf(ms * (x[1] - 0.5f));
+            c.z += a[2] * expf(ms * (x[2] - 0.5f));
+        } else if (m.multiple) { // the light scattered more than once, log-encoded
             const float* x = enc + 3 * m.terms;
             c.x += decode_log(x[0], m.multiple_max[0], kMultipleLogRange);
             c.y += decode_log(x[1], m.multiple_max[1], kMultipleLogRange);
@@ -480,7 +614,7 @@ SKYBAKE_HD_INLINE glm::vec3 neural_sky(const MlpHD& m, float cos_view_zenith, fl
     mlp_forward(m, in, enc);
     if (m.output_kind == kOutputsResidual) {
         float base[kMaxOutputs];
-        analytic_terms(m, cos_view_zenith, cos_view_sun, cos_sun_zenith, density, base);
+        analytic_base(m, cos_view_zenith, cos_view_sun, cos_sun_zenith, density, base);
         return decode_sky(m, enc, cos_view_sun, base);
     }
     return decode_sky(m, enc, cos_view_sun);

@@ -131,6 +131,18 @@ void NeuralSky::validate(const std::string& where) const {
                   encoding.multiple_max[c] <= 1e30))
                 throw Error("encoding.multiple_max must be numbers in [1e-30, 1e30]", where);
     }
+    if (encoding.multiple_marched()) {
+        const std::string pw = where + ": encoding.multiple_psi";
+        if (!encoding.multiple)
+            throw Error("a marched multiple-scattering term needs encoding.multiple_max", pw);
+        if (encoding.multiple_psi.size() != std::size_t(3 * neural::kPsiCoefficients))
+            throw Error(fmt::format("log_psi must be 3 rows of {} coefficients", neural::kPsiCoefficients), pw);
+        for (double a : encoding.multiple_psi)
+            if (!(std::isfinite(a) && std::abs(a) <= 1e4))
+                throw Error("log_psi must be numbers in [-1e4, 1e4]", pw);
+        if (!(encoding.multiple_psi_mu_min >= -0.99 && encoding.multiple_psi_mu_min <= 0.5))
+            throw Error("mu_s_min must be in [-0.99, 0.5]", pw);
+    }
     if (encoding.outputs == OutputEncoding::Residual)
         neural::check_residual_atmosphere(encoding, atmosphere, where);
     if (encoding.has_family())
@@ -192,6 +204,13 @@ std::string neural_sky_to_json(const NeuralSky& net) {
     }
     if (e.multiple)
         j["encoding"]["multiple_max"] = {e.multiple_max.x, e.multiple_max.y, e.multiple_max.z};
+    if (e.multiple_marched()) {
+        json rows = json::array();
+        for (int c = 0; c < 3; ++c)
+            rows.push_back(std::vector<double>(e.multiple_psi.begin() + c * neural::kPsiCoefficients,
+                                               e.multiple_psi.begin() + (c + 1) * neural::kPsiCoefficients));
+        j["encoding"]["multiple_psi"] = {{"mu_s_min", e.multiple_psi_mu_min}, {"log_psi", std::move(rows)}};
+    }
     if (e.has_family()) {
         j["topology"]["inputs"] = net.topology.inputs;
         j["encoding"]["family"] = {{"component", e.family_component},
@@ -329,6 +348,24 @@ NeuralSky neural_sky_from_json(std::string_view text, const std::string& where) 
                     throw Error("encoding.multiple_max must be [r, g, b]", where);
                 net.encoding.multiple = true;
                 net.encoding.multiple_max = glm::dvec3(mm[0].get<double>(), mm[1].get<double>(), mm[2].get<double>());
+            }
+            if (enc.contains("multiple_psi")) {
+                const std::string pw = where + ": encoding.multiple_psi";
+                const json& mp = enc["multiple_psi"];
+                const json& rows = field(mp, "log_psi", pw);
+                if (!rows.is_array() || rows.size() != 3)
+                    throw Error("log_psi must be 3 rows of coefficients", pw);
+                net.encoding.multiple_psi_mu_min = number(mp, "mu_s_min", pw);
+                for (const json& row : rows) {
+                    if (!row.is_array() || row.size() != std::size_t(neural::kPsiCoefficients))
+                        throw Error(fmt::format("log_psi must be 3 rows of {} coefficients", neural::kPsiCoefficients),
+                                    pw);
+                    for (const json& a : row) {
+                        if (!a.is_number())
+                            throw Error("log_psi must hold numbers", pw);
+                        net.encoding.multiple_psi.push_back(a.get<double>());
+                    }
+                }
             }
             if (enc.contains("family")) {
                 const std::string fw = where + ": encoding.family";

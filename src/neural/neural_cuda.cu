@@ -102,7 +102,7 @@ __device__ __forceinline__ glm::vec3 residual_network(MlpHD m, const float* weig
     m.weights = weights ? weights : c_weights;
     float enc[kMaxOutputs], base[kMaxOutputs];
     mlp_forward(m, in, enc);
-    analytic_terms(m, cv, cvs, cs, rho, base);
+    analytic_base(m, cv, cvs, cs, rho, base);
     return decode_sky(m, enc, cvs, base);
 }
 

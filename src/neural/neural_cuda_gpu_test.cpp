@@ -75,6 +75,16 @@ TEST(NeuralCuda, EveryEncodingMatchesTheCpu) {
                              output_encoding_name(outputs));
                 expect_within_modelled_bound(net, samples, cpu, gpu);
             }
+    {   // Multiple scattering, its term a correction of the isotropic march.
+        const NeuralSky marched = with_marched_multiple(with_encoding(
+            random_network("shared:16x12", 4), InputEncoding::Horizon, OutputEncoding::Residual, 12, true));
+        const auto samples = draw_sky_samples(50000, 23);
+        std::vector<glm::vec3> cpu(samples.size()), gpu(samples.size());
+        evaluate_neural_sky(marched, samples, cpu);
+        evaluate_neural_sky_cuda(marched, samples, gpu);
+        SCOPED_TRACE("shared:16x12, multiple scattering marched");
+        expect_within_modelled_bound(marched, samples, cpu, gpu);
+    }
     // An aerosol family: the fifth input and the scaled, Chapman-view march.
     const NeuralSky family = with_family(
         with_encoding(random_network("shared:16x12", 4), InputEncoding::Horizon, OutputEncoding::Residual, 12), 1.0,

@@ -884,7 +884,8 @@ TEST(ImagePsnr, IsTheClosedFormAndANaNPixelIsTheLargestError) {
 TEST(NeuralSky, SharedTestVectorsAreTheScalarPass) {
     const std::filesystem::path file = std::filesystem::path(SKYBAKE_SOURCE_DIR) / "tests/data/neural/test_vectors.json";
     const char* networks[] = {"v1_paper.json", "v1_shared_linear.json", "v3_earth_default.json",
-                              "v3_earth_residual.json", "v3_earth_multiple.json"};
+                              "v3_earth_residual.json", "v3_earth_multiple.json",
+                              "v3_earth_multiple_march.json"};
     if (const char* w = std::getenv("SKYBAKE_WRITE_TEST_VECTORS"); w && std::string(w) == "1") {
         nlohmann::ordered_json out = {{"format", "skybake-neural-test-vectors"}, {"version", 1},
                                       {"columns", {"cos_view_zenith", "cos_view_sun", "cos_sun_zenith", "density", "r", "g", "b"}}};

@@ -13,10 +13,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <numeric>
 #include <optional>
 
 #include <Eigen/Cholesky>
+#include <Eigen/QR>
+#include <glm/vec2.hpp>
 #include <fmt/format.h>
 
 #include "core/parallel.h"
@@ -145,7 +148,8 @@ std::vector<SkySample> neural::draw_hard_samples(std::size_t n, std::uint64_t se
 }
 
 TrainingData neural::make_training_data(const SkyModel& model, const NeuralEncoding& enc, std::size_t n,
-                                        std::uint64_t seed, Device device, double hard_share) {
+                                        std::uint64_t seed, Device device, double hard_share,
+                                        double flight_share) {
     DataSet d;
     std::vector<SkySample> s = draw_sky_samples(n, seed);
     if (hard_share > 0.0) { // every k-th sample from where the sky is hard
@@ -153,6 +157,12 @@ TrainingData neural::make_training_data(const SkyModel& model, const NeuralEncod
         const std::vector<SkySample> h = draw_hard_samples(hard, seed ^ 0x4a4d4a4dull, model.atmosphere());
         for (std::size_t j = 0; j < hard; ++j)
             s[std::min(n - 1, std::size_t(double(j) / hard_share))] = h[j];
+    }
+    if (flight_share > 0.0) { // then every k-th sample from a flight's (draw_flight_samples)
+        const std::size_t k = std::size_t(std::llround(flight_share * double(n)));
+        const std::vector<SkySample> f = draw_flight_samples(k, seed ^ 0x5151f11eull, model.atmosphere());
+        for (std::size_t j = 0; j < k; ++j)
+            s[std::min(n - 1, std::size_t(double(j) / flight_share))] = f[j];
     }
     MlpHD hd;
     set_encoding_hd(enc, model.atmosphere(), hd);
@@ -179,8 +189,19 @@ TrainingData neural::make_training_data(const SkyModel& model, const NeuralEncod
             for (std::size_t i = 0; i < n; ++i) {
                 const glm::vec3 more = glm::max(total[i] - d.radiance[i], glm::vec3(0.0f));
                 for (int c = 0; c < 3; ++c) {
-                    d.t(rows + c, Eigen::Index(i)) = encode_log(double(more[c]), enc.multiple_max[c], double(kMultipleLogRange));
-                    d.mask(rows + c, Eigen::Index(i)) = 1.0f;
+                    const Eigen::Index row = rows + c;
+                    if (enc.multiple_marched()) { // a log ratio to the isotropic march, as the terms'
+                        const double ms = double(more[c]), a = double(d.base(row, Eigen::Index(i)));
+                        const bool lit = ms > 0.0 && a > 0.0;
+                        const double x = lit ? std::clamp(std::log(ms / a) / double(kResidualRange), -1.0, 1.0)
+                                             : 0.0;
+                        d.t(row, Eigen::Index(i)) = float(0.5 + 0.5 * double(kEncodeScale) * x);
+                        d.mask(row, Eigen::Index(i)) = lit ? 1.0f : 0.0f;
+                    } else {
+                        d.t(row, Eigen::Index(i)) =
+                            encode_log(double(more[c]), enc.multiple_max[c], double(kMultipleLogRange));
+                        d.mask(row, Eigen::Index(i)) = 1.0f;
+                    }
                 }
             }
             d.radiance = std::move(total);
@@ -354,6 +375,63 @@ NormalPart normal_equations(const Layout& lay, const std::vector<float>& w, int 
 
 } // namespace
 
+std::vector<double> neural::fit_multiple_psi(const SkyModel& model, double mu_s_min, Device device) {
+    // The sky's mean radiance over the sphere (a Fibonacci sphere of 512
+    // directions) at 25 altitudes × 121 sun elevations, uniform from the
+    // ground to the top and from asin(mu_s_min) to 90°.
+    const Atmosphere& atm = model.atmosphere();
+    constexpr int kAltitudes = 25, kElevations = 121, kDirections = 512;
+    const double pi = 3.14159265358979323846, golden = pi * (3.0 - std::sqrt(5.0));
+    const double top = atm.top_radius_km - atm.planet_radius_km, e0 = std::asin(mu_s_min);
+    std::vector<SkySample> s;
+    s.reserve(std::size_t(kAltitudes * kElevations * kDirections));
+    std::vector<glm::dvec2> node; // (x, y) of each node, as psi_log maps them
+    for (int ih = 0; ih < kAltitudes; ++ih) {
+        const double h = top * ih / (kAltitudes - 1);
+        const float rho = float(std::max(atm.density_from_altitude(h), 1e-30));
+        for (int ie = 0; ie < kElevations; ++ie) {
+            const double mu_s = std::sin(e0 + (pi / 2 - e0) * ie / (kElevations - 1));
+            const double ss = std::sqrt(std::max(0.0, 1.0 - mu_s * mu_s));
+            node.push_back({2.0 * h / top - 1.0, (2.0 * mu_s - 1.0 - mu_s_min) / (1.0 - mu_s_min)});
+            for (int i = 0; i < kDirections; ++i) {
+                const double z = 1.0 - 2.0 * (i + 0.5) / kDirections, x = std::sqrt(std::max(0.0, 1.0 - z * z));
+                const double nu = z * mu_s + x * ss * std::cos(golden * i);
+                s.push_back({float(z), float(std::clamp(nu, -1.0, 1.0)), float(mu_s), rho});
+            }
+        }
+    }
+    std::vector<glm::vec3> radiance(s.size());
+    sky_targets(model, s, radiance, device);
+    const Eigen::Index rows = Eigen::Index(node.size());
+    Eigen::MatrixXd A(rows, kPsiCoefficients), b(rows, 3);
+    for (Eigen::Index n = 0; n < rows; ++n) {
+        glm::dvec3 mean(0.0);
+        for (int i = 0; i < kDirections; ++i)
+            mean += glm::dvec3(radiance[std::size_t(n) * kDirections + std::size_t(i)]);
+        mean /= double(kDirections);
+        for (int c = 0; c < 3; ++c)
+            b(n, c) = std::log(std::max(mean[c], 1e-30));
+        double xi = 1.0;
+        for (int i = 0; i <= kPsiAltitudeDegree; ++i, xi *= node[std::size_t(n)].x) {
+            double yj = 1.0;
+            for (int j = 0; j <= kPsiSunDegree; ++j, yj *= node[std::size_t(n)].y)
+                A(n, i * (kPsiSunDegree + 1) + j) = xi * yj;
+        }
+    }
+    const Eigen::MatrixXd a = A.colPivHouseholderQr().solve(b);
+    std::vector<double> out;
+    for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < kPsiCoefficients; ++i)
+            out.push_back(a(i, c));
+    return out;
+}
+
+double neural::effective_flight_share(const NeuralTrainOptions& o, const Atmosphere& atmosphere) {
+    if (o.flight_share >= 0.0)
+        return o.flight_share;
+    return atmosphere.scattering == Scattering::Single ? 0.0 : kMultipleFlightShare;
+}
+
 OutputEncoding default_output_encoding(const Atmosphere& atmosphere) {
     NeuralEncoding e;
     e.outputs = OutputEncoding::Residual;
@@ -420,6 +498,8 @@ NeuralEncoding neural::make_training_encoding(const SkyModel& model, const Neura
                 encoding.multiple_max = glm::dvec3(1e-30);
                 for (std::size_t i = 0; i < s.size(); ++i)
                     encoding.multiple_max = glm::max(encoding.multiple_max, glm::dvec3(total[i] - r[i]));
+                if (o.multiple_march)
+                    encoding.multiple_psi = fit_multiple_psi(model, encoding.multiple_psi_mu_min, o.device);
                 r = std::move(total);
             }
         } else {
@@ -457,6 +537,8 @@ NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, s
         throw Error("the mini-batch must hold 1 to `samples` samples", "batch");
     if (!(o.hard_share >= 0.0 && o.hard_share <= 1.0))
         throw Error("the share of hard samples must be in [0, 1]", "hard_share");
+    if (!(o.flight_share <= 1.0) || (o.flight_share < 0.0 && o.flight_share != -1.0))
+        throw Error("the share of a flight's samples must be in [0, 1], or -1 for automatic", "flight_share");
     if (!(o.learning_rate > 0.0 && o.learning_rate_final > 0.0 && o.learning_rate < 10.0))
         throw Error("learning rates must be positive (and below 10)", "learning_rate");
     if ((o.brightness == BrightnessEncoding::Log || has_phase_terms(o.outputs)) &&
@@ -471,7 +553,8 @@ NeuralSky train_neural_sky(const SkyModel& model, const NeuralTrainOptions& o, s
     net.topology.outputs = net.encoding.output_count();
     net.topology.inputs = net.encoding.input_count();
     const DataSet train =
-        make_training_data(model, net.encoding, o.samples, stream_seed(o.seed, 0), o.device, o.hard_share);
+        make_training_data(model, net.encoding, o.samples, stream_seed(o.seed, 0), o.device, o.hard_share,
+                           effective_flight_share(o, model.atmosphere()));
     const DataSet held = make_training_data(model, net.encoding, o.heldout_samples, stream_seed(o.seed, 1), o.device);
     return train_network(std::move(net), train, held, o, curve, t0);
 }

@@ -208,16 +208,19 @@ TEST(GlNetwork, EveryEncodingMatchesTheCppForwardPass) {
     // Residual outputs of a sky with multiple scattering: the multiply
     // scattered light's term and its constants in the uniform block, in
     // desktop GLSL and in GLSL ES.
-    for (ExportLanguage lang : {ExportLanguage::Glsl, ExportLanguage::GlslEs}) {
-        const NeuralSky net = encoded_network(InputEncoding::Horizon, OutputEncoding::Residual, true);
-        int compared = 0;
-        const double err = glsl_network_error(net, &compared, lang);
-        EXPECT_GT(compared, 3000);
-        EXPECT_LT(err, 1e-5);
-        std::printf("%s network (residual outputs, multiple scattering) vs mlp_hd.h: max relative error %.3g over %d "
-                    "inputs\n",
-                    lang == ExportLanguage::Glsl ? "GLSL" : "GLSL ES", err, compared);
-    }
+    for (ExportLanguage lang : {ExportLanguage::Glsl, ExportLanguage::GlslEs})
+        for (bool march : {false, true}) { // log-encoded, or a correction of the isotropic march (ψ in the block)
+            NeuralSky net = encoded_network(InputEncoding::Horizon, OutputEncoding::Residual, true);
+            if (march)
+                net = neural_test::with_marched_multiple(std::move(net));
+            int compared = 0;
+            const double err = glsl_network_error(net, &compared, lang);
+            EXPECT_GT(compared, 3000);
+            EXPECT_LT(err, 1e-5) << (march ? "marched" : "log-encoded");
+            std::printf("%s network (residual outputs, multiple scattering%s) vs mlp_hd.h: max relative error %.3g "
+                        "over %d inputs\n",
+                        lang == ExportLanguage::Glsl ? "GLSL" : "GLSL ES", march ? ", marched" : "", err, compared);
+        }
     // An aerosol family: its fifth input and the march's scaled aerosol, the
     // amount read from the uniform block (the renderers' path).
     for (ExportLanguage lang : {ExportLanguage::Glsl, ExportLanguage::GlslEs}) {

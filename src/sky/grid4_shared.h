@@ -98,7 +98,7 @@ SKYBAKE_HD_INLINE int grid4_mus_cell_below_horizon(Real x_horizon, int nmus, int
 
 // The value between the μs nodes' values a (lower) and b at fraction f:
 // linear, or geometric in a cell below the horizon (values floored at 1e-30,
-// below any light the grids hold).
+// below any light the grids hold; 0 where both are).
 SKYBAKE_HD_INLINE Real grid4_mus_blend(Real a, Real b, Real f, int below_horizon) {
     if (below_horizon == 0)
         return a + f * (b - a);
@@ -107,6 +107,8 @@ SKYBAKE_HD_INLINE Real grid4_mus_blend(Real a, Real b, Real f, int below_horizon
         return a;
     if (f > Real(1) - Real(1e-6))
         return b;
+    if (!(a > Real(1e-30)) && !(b > Real(1e-30)))
+        return Real(0); // no light at either node: none between them
     Real la = SB_REAL_LOG(a > Real(1e-30) ? a : Real(1e-30));
     Real lb = SB_REAL_LOG(b > Real(1e-30) ? b : Real(1e-30));
     return SB_REAL_EXP(la + f * (lb - la));

@@ -66,6 +66,11 @@ function decodeLog(x, max, logRange) {
 const RESIDUAL_STEPS = 4;
 const RESIDUAL_SCALE = f(2 / f(0.5 * ENCODE_SCALE));
 const MULTIPLE_LOG_RANGE = f(27.6310211); // kMultipleLogRange: 12 decades
+// Or the term as a correction of an isotropic march (kMultipleSteps, and the
+// degrees of ln psi's polynomial: kPsiAltitudeDegree, kPsiSunDegree).
+const MULTIPLE_STEPS = 4;
+const PSI_ALTITUDE_DEGREE = 2, PSI_SUN_DEGREE = 6;
+const PSI_COEFFICIENTS = (PSI_ALTITUDE_DEGREE + 1) * (PSI_SUN_DEGREE + 1);
 
 function periapsisAltitude(h, R0, cosChi) {
   const s2 = f(f(1 - cosChi) * f(1 + cosChi));
@@ -131,6 +136,17 @@ export class NeuralSky {
       if (this.outputKind !== 'residual' || !Array.isArray(e.multiple_max) || e.multiple_max.length !== 3)
         fail('encoding.multiple_max must be [r, g, b], with residual outputs');
       this.multipleMax = e.multiple_max.map((m) => finiteNumber(m, 'encoding.multiple_max'));
+    }
+    // Or, marched: ln psi's polynomial (mlp_hd.h's psi_log) and its lowest sun cosine.
+    this.psi = null;
+    if (e.multiple_psi !== undefined) {
+      const rows = e.multiple_psi.log_psi;
+      if (!this.multipleMax || !Array.isArray(rows) || rows.length !== 3 ||
+          rows.some((row) => !Array.isArray(row) || row.length !== PSI_COEFFICIENTS))
+        fail(`encoding.multiple_psi needs multiple_max and log_psi: 3 rows of ${PSI_COEFFICIENTS} coefficients`);
+      const muMin = finiteNumber(e.multiple_psi.mu_s_min, 'encoding.multiple_psi.mu_s_min');
+      if (!(muMin >= -0.99 && muMin <= 0.5)) fail('encoding.multiple_psi.mu_s_min must be in [-0.99, 0.5]');
+      this.psi = { muMin: f(muMin), a: rows.map((row) => Float32Array.from(row, (x) => finiteNumber(x, 'log_psi'))) };
     }
     const outputs = factored ? 3 * this.terms.length + (this.multipleMax ? 3 : 0) : 4;
     // An aerosol family: the amount of one component is a fifth input, set at
@@ -246,13 +262,15 @@ export class NeuralSky {
 
   // Residual outputs: the analytic single scattering per term and channel
   // (mlp_hd.h's analytic_terms), without the phase functions.
-  analyticTerms(mu, nu, muS, density) {
+  // The observer and its view ray (mlp_hd.h's view_ray_precise): the
+  // unclamped altitude hr, the altitude h clamped to the atmosphere, r, rho
+  // and the ray's length d.
+  viewRay(mu, density) {
     const R0 = f(this.R0), top = f(f(this.Rtop) - R0), two = f(2 * R0);
-    const base = new Float32Array(3 * this.terms.length);
     const u = f(f(density - 1) / f(density + 1)), u2 = f(u * u);
     const ln = density > f(0.97) ? f(f(2 * u) * f(1 + f(u2 * f(f(0.333333343) + f(u2 * f(0.2)))))) : f(Math.log(density));
-    let h = f(-f(this.scaleHeight) * ln);
-    h = h > 0 ? (h < top ? h : top) : 0;
+    const hr = f(-f(this.scaleHeight) * ln);
+    const h = hr > 0 ? (hr < top ? hr : top) : 0;
     const r = f(R0 + h);
     const rho = f(Math.sqrt(f(h * f(two + h))));
     const rc = f(r * mu), arc = Math.abs(rc);
@@ -266,6 +284,22 @@ export class NeuralSky {
       const s = f(Math.sqrt(disc > 0 ? disc : 0));
       d = rc > 0 ? f(k / f(rc + s)) : f(-rc + s);
     }
+    return { hr, h, r, rho, d };
+  }
+
+  // An observer above the top (the inputs see it at the top) whose ray misses
+  // the atmosphere sees no air (mlp_hd.h's misses_atmosphere).
+  missesAtmosphere(mu, hr) {
+    const R0 = f(this.R0), top = f(f(this.Rtop) - R0);
+    const r = f(R0 + hr), rt = f(R0 + top), s2 = f(f(1 - mu) * f(1 + mu));
+    return hr > top && (mu >= 0 || f(f(r * r) * s2) >= f(rt * rt));
+  }
+
+  analyticTerms(mu, nu, muS, density) {
+    const R0 = f(this.R0);
+    const base = new Float32Array(3 * this.terms.length);
+    const { hr, h, r, rho, d } = this.viewRay(mu, density);
+    if (this.missesAtmosphere(mu, hr)) return base;
     // The planet's shadow on the ray (shadow_span).
     let lo = 0, hi = d, shadow = true;
     const c = f(r * muS);
@@ -361,6 +395,55 @@ export class NeuralSky {
     return base;
   }
 
+  // Residual outputs' multiple-scattering term, marched: the isotropic march of
+  // the sky's mean radiance psi per channel (mlp_hd.h's analytic_multiple).
+  analyticMultiple(mu, nu, muS, density) {
+    const R0 = f(this.R0), top = f(f(this.Rtop) - R0);
+    const out = [0, 0, 0];
+    const { hr, h, r, rho, d } = this.viewRay(mu, density);
+    if (this.missesAtmosphere(mu, hr)) return out;
+    const rho2 = f(rho * rho), twoRMu = f(f(2 * r) * mu);
+    const altitude = (t) => {
+      let q = f(rho2 + f(t * f(twoRMu + t)));
+      q = q > 0 ? q : 0;
+      return f(q / f(f(Math.sqrt(f(q + f(R0 * R0)))) + R0));
+    };
+    const dt = f(d * f(1 / MULTIPLE_STEPS));
+    const prev = this.ext.map((e) => f(Math.exp(f(-h / f(e.H)))));
+    const tau = [0, 0, 0];
+    const { muMin, a } = this.psi;
+    const row = PSI_SUN_DEGREE + 1;
+    for (let k = 0; k < MULTIPLE_STEPS; ++k) {
+      const tm = f(f(k + 0.5) * dt), te = f(f(k + 1) * dt);
+      const hm = altitude(tm), he = altitude(te);
+      const mus = f(f(f(r * muS) + f(tm * nu)) / f(R0 + hm));
+      const mid = this.ext.map((e) => f(Math.exp(f(-hm / f(e.H)))));
+      const end = this.ext.map((e) => f(Math.exp(f(-he / f(e.H)))));
+      let px = f(f(f(2 * hm) / top) - 1);
+      let py = f(f(f(f(2 * mus) - 1) - muMin) / f(1 - muMin));
+      px = px > -1 ? (px < 1 ? px : 1) : -1;
+      py = py > -1 ? (py < 1 ? py : 1) : -1;
+      for (let ch = 0; ch < 3; ++ch) {
+        let dtau = 0, sca = 0;
+        this.ext.forEach((e, i) => { dtau = f(dtau + f(f(f(f(e.beta[ch]) * 0.5) * f(prev[i] + end[i])) * dt)); });
+        this.terms.forEach((t) => { sca = f(sca + f(f(t.beta[ch]) * mid[t.ext])); });
+        const fac = dtau > f(0.1) ? f(f(1 - f(Math.exp(-dtau))) / dtau)
+          : f(1 - f(dtau * f(0.5 - f(dtau * f(f(0.166666672) - f(dtau * f(0.0416666679)))))));
+        const w = f(f(f(f(Math.exp(-tau[ch])) * sca) * dt) * fac);
+        tau[ch] = f(tau[ch] + dtau);
+        let acc = 0;
+        for (let i = PSI_ALTITUDE_DEGREE; i >= 0; --i) {
+          let v = 0;
+          for (let j = PSI_SUN_DEGREE; j >= 0; --j) v = f(f(v * py) + a[ch][i * row + j]);
+          acc = f(f(acc * px) + v);
+        }
+        out[ch] = f(out[ch] + f(w * f(Math.exp(acc))));
+      }
+      for (let i = 0; i < prev.length; ++i) prev[i] = end[i];
+    }
+    return out;
+  }
+
   // The encoded outputs for the four inputs.
   forward(inputs) {
     const enc = new Float32Array(this.outputs);
@@ -400,7 +483,12 @@ export class NeuralSky {
         for (let ch = 0; ch < 3; ++ch)
           c[ch] = f(c[ch] + f(f(p * base[3 * k + ch]) * f(Math.exp(f(RESIDUAL_SCALE * f(enc[3 * k + ch] - 0.5))))));
       });
-      if (this.multipleMax) {
+      if (this.psi) {
+        const at = 3 * this.terms.length;
+        const m = this.analyticMultiple(f(cosViewZenith), f(cosViewSun), f(cosSunZenith), f(density));
+        for (let ch = 0; ch < 3; ++ch)
+          c[ch] = f(c[ch] + f(m[ch] * f(Math.exp(f(RESIDUAL_SCALE * f(enc[at + ch] - 0.5))))));
+      } else if (this.multipleMax) {
         const at = 3 * this.terms.length;
         for (let ch = 0; ch < 3; ++ch) c[ch] = f(c[ch] + decodeLog(enc[at + ch], f(this.multipleMax[ch]), MULTIPLE_LOG_RANGE));
       }

@@ -37,7 +37,7 @@ test('NeuralSky draws the network of the weights file, and skybakeLighting light
   const dir = mkdtempSync(join(tmpdir(), 'skybake-web-'));
   const networks = [];
   for (const name of ['v3_earth_default.json', 'v1_paper.json', 'v1_shared_linear.json', 'v3_earth_residual.json',
-    'v3_earth_multiple.json']) {
+    'v3_earth_multiple.json', 'v3_earth_multiple_march.json']) {
     const weightsFile = join(process.env.SKYBAKE_TEST_DATA, 'neural', name);
     const glslFile = join(dir, `${name}.glsl`);
     execFileSync(process.env.SKYBAKE_CLI, ['sky', 'export', weightsFile, '--format', 'glsl-es', '-o', glslFile], { stdio: 'ignore' });

@@ -59,7 +59,8 @@ for (const [file, what, aerosol] of [
   ['neural/v1_shared_linear.json', 'a shared network, linear brightness'],
   ['neural/v3_earth_default.json', 'horizon inputs, phase-factored outputs'],
   ['neural/v3_earth_residual.json', 'the default: horizon inputs, residual outputs'],
-  ['neural/v3_earth_multiple.json', 'the default with multiple scattering: residual outputs and their term'],
+  ['neural/v3_earth_multiple.json', 'multiple scattering: residual outputs and their term, log-encoded'],
+  ['neural/v3_earth_multiple_march.json', 'the default with multiple scattering: its term a correction of the isotropic march'],
   ['neural/v3_earth_family.json', 'an aerosol family at 5 times the aerosol', 5],
   ['neural/v3_earth_family.json', 'an aerosol family at its hazy end, 32 times', 32],
 ]) {
