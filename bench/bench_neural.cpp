@@ -118,7 +118,8 @@ void BM_NeuralScalarOneCore(benchmark::State& state) {
 
 // The default network's size with phase-factored (0) or residual (1) outputs,
 // or residual outputs of an aerosol family (2: a fifth input and the view's
-// depth from Chapman integrals), horizon inputs: what the analytic march of
+// depth from Chapman integrals), or of the whole sky's light (3: the
+// multiple-scattering term log-encoded; 4: marched), horizon inputs: what the analytic march of
 // the residual costs per sample in the scalar pass (the exported shaders'
 // arithmetic), against the same network without it, measured in the same run.
 void BM_NeuralScalarOutputs(benchmark::State& state) {
@@ -130,6 +131,16 @@ void BM_NeuralScalarOutputs(benchmark::State& state) {
         const AtmosphereComponent& c = net.atmosphere.components[std::size_t(k)];
         net.encoding.terms.push_back({c.name, c.phase, c.phase_g, glm::dvec3(1.0)});
     }
+    if (state.range(0) >= 3) { // the whole sky's light: the term log-encoded (3) or marched (4)
+        net.atmosphere.scattering = Scattering::Multiple;
+        net.encoding.multiple = true;
+        net.encoding.multiple_max = glm::dvec3(0.02, 0.03, 0.04);
+        if (state.range(0) == 4)
+            for (int c = 0; c < 3; ++c) {
+                net.encoding.multiple_psi.resize(std::size_t((c + 1) * neural::kPsiCoefficients), 0.0);
+                net.encoding.multiple_psi[std::size_t(c * neural::kPsiCoefficients)] = std::log(0.02);
+            }
+    }
     net.topology.outputs = net.encoding.output_count();
     if (state.range(0) == 2) {
         net.encoding.family_component = "mie";
@@ -138,8 +149,9 @@ void BM_NeuralScalarOutputs(benchmark::State& state) {
         net.aerosol = 3.0;
     }
     net.weights.resize(std::size_t(net.topology.weight_count()), 0.01f);
+    const char* what[] = {"", "", ", aerosol family", ", multiple scattering log-encoded", ", multiple scattering marched"};
     state.SetLabel(fmt::format("shared:16x12, horizon/{}{} ({} weights)", output_encoding_name(net.encoding.outputs),
-                               state.range(0) == 2 ? ", aerosol family" : "", net.topology.weight_count()));
+                               what[state.range(0)], net.topology.weight_count()));
     const neural::MlpHD hd = neural::make_mlp_hd(net);
     scalar_pass(state, hd, base);
 }
@@ -195,7 +207,7 @@ void compare_sample_counts(const std::filesystem::path& dir) {
 BENCHMARK(BM_SkyTables)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_NeuralBatch)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_NeuralScalarOneCore)->Arg(0)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_NeuralScalarOutputs)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_NeuralScalarOutputs)->DenseRange(0, 4)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_TrainPaper800k)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 
 int main(int argc, char** argv) {

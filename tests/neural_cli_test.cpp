@@ -96,6 +96,10 @@ TEST(NeuralCli, TrainRejectsBadFlags) {
              {"--brightness", "cubic"},
              {"--hard-share", "nan"},
              {"--hard-share", "1.5"},
+             {"--flight-share", "-0.1"},
+             {"--flight-share", "nan"},
+             {"--multiple-term", "cubic"},
+             {"--multiple-term", "log"}, // with single scattering
              {"--samples", "3"},
              {"--chart", dir + "/c.jpg"},
              {"--preset", "mars"}}) {

@@ -97,6 +97,12 @@ def test_an_aerosol_family_takes_its_amount_at_run_time(earth):
     assert np.abs(hard.weights - plain.weights).max() > 0.0
     with pytest.raises(skybake.Error, match="hard"):
         skybake.train_sky(earth, samples=2000, adam_epochs=1, lm_iterations=0, hard_share=2.0)
+    with pytest.raises(skybake.Error, match="flight_share"):
+        skybake.train_sky(earth, samples=2000, adam_epochs=1, lm_iterations=0, flight_share=1.5)
+    with pytest.raises(skybake.Error, match="multiple_term"):
+        skybake.train_sky(earth, samples=2000, adam_epochs=1, lm_iterations=0, multiple_term="cubic")
+    flown = skybake.train_sky(earth, samples=2000, adam_epochs=1, lm_iterations=0, flight_share=0.5)
+    assert np.abs(flown.weights - plain.weights).max() > 0.0
     with pytest.raises(skybake.Error, match="aerosol"):
         plain.aerosol = 2.0
 
