@@ -303,6 +303,29 @@ TEST(NeuralCli, TheSeedsNetworkIsOneFlagSet) {
     EXPECT_NE(bad.err.find("--inputs"), std::string::npos) << bad.err;
 }
 
+// What is not asked for comes from the schedule measured for the network's
+// size (training_schedule): 150 epochs from 0.01 and no LM at 64 wide; a flag
+// overrides its part only.
+TEST(NeuralCli, TrainFollowsTheSizesSchedule) {
+    const std::string dir = temp_dir("neural_schedule");
+    auto wide = run_cli({"sky", "train", "--preset", "paper", "--samples", "1000", "--heldout", "100", "--topology",
+                         "shared:64x4", "-o", dir + "/w.json", "--json"});
+    ASSERT_EQ(wide.exit_code, 0) << wide.err;
+    auto j = nlohmann::json::parse(wide.out);
+    EXPECT_EQ(j["adam_epochs"], 150);
+    EXPECT_EQ(j["lm_iterations"], 0);
+    auto asked = run_cli({"sky", "train", "--preset", "paper", "--samples", "1000", "--heldout", "100", "--topology",
+                          "shared:64x4", "--epochs", "2", "-o", dir + "/w.json", "--json"});
+    ASSERT_EQ(asked.exit_code, 0) << asked.err;
+    j = nlohmann::json::parse(asked.out);
+    EXPECT_EQ(j["adam_epochs"], 2);
+    EXPECT_EQ(j["lm_iterations"], 0);
+    auto mid = run_cli({"sky", "train", "--preset", "paper", "--samples", "1000", "--heldout", "100", "--topology",
+                        "shared:24x8", "--epochs", "1", "-o", dir + "/w.json", "--json"});
+    ASSERT_EQ(mid.exit_code, 0) << mid.err;
+    EXPECT_EQ(nlohmann::json::parse(mid.out)["lm_iterations"], 3);
+}
+
 TEST(NeuralCli, CorruptWeightsAreOneLineErrors) {
     const std::string dir = temp_dir("neural_corrupt");
     const std::string good = read(tiny_model());

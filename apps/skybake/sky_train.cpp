@@ -49,18 +49,20 @@ void add_sky_train(CLI::App& group) {
     sub->add_option("--log-range", o->log_range_decades, "Decades of N/max{N} the log brightness covers")
         ->check(real_in(0.0, 80.0, "decades", End::Open))
         ->capture_default_str();
-    sub->add_option("--epochs", o->t.adam_epochs, "Adam epochs")->check(integer_in(0, 100'000))->capture_default_str();
-    sub->add_option("--lm-iterations", o->t.lm_iterations, "Levenberg-Marquardt iterations after Adam")
-        ->check(integer_in(0, 10'000))
-        ->capture_default_str();
+    sub->add_option("--epochs", o->t.adam_epochs,
+                    "Adam epochs (default: the size's measured schedule, 60 up to 32 wide, 150 up to 64, 30 wider)")
+        ->check(integer_in(0, 100'000));
+    sub->add_option("--lm-iterations", o->t.lm_iterations,
+                    "Levenberg-Marquardt iterations after Adam (default: 20 up to 16 wide, 3 up to 32, else 0)")
+        ->check(integer_in(0, 10'000));
     sub->add_option("--lm-samples", o->t.lm_samples, "Samples in the LM least squares (0: automatic)")
         ->check(integer_in(0, 100'000'000))
         ->capture_default_str();
     sub->add_option("--batch", o->t.batch, "Adam mini-batch, in samples (default 1024, or --samples if fewer)")
         ->check(integer_in(1, 100'000'000));
-    sub->add_option("--learning-rate", o->t.learning_rate, "Adam step size of the first epoch")
-        ->check(real_in(0.0, 10.0, "", End::Open))
-        ->capture_default_str();
+    sub->add_option("--learning-rate", o->t.learning_rate,
+                    "Adam step size of the first epoch (default: 0.02 up to 32 wide, 0.01 up to 64, 0.005 wider)")
+        ->check(real_in(0.0, 10.0, "", End::Open));
     sub->add_option("--learning-rate-final", o->t.learning_rate_final, "Adam step size of the last epoch")
         ->check(real_in(0.0, 10.0, "", End::Open))
         ->capture_default_str();
@@ -114,6 +116,15 @@ void add_sky_train(CLI::App& group) {
         if (!given(*sub, "--table-rule"))
             atm.table_rule = TableRule::Refined;
         o->t.topology = parse_flag("--topology", [&] { return parse_topology(o->topology); });
+        { // the schedule measured for the network's size, for what is not asked for
+            const NeuralSchedule schedule = training_schedule(o->t.topology);
+            if (!given(*sub, "--epochs"))
+                o->t.adam_epochs = schedule.adam_epochs;
+            if (!given(*sub, "--learning-rate"))
+                o->t.learning_rate = schedule.learning_rate;
+            if (!given(*sub, "--lm-iterations"))
+                o->t.lm_iterations = schedule.lm_iterations;
+        }
         o->t.brightness = parse_flag("--brightness", [&] { return parse_brightness_encoding(o->brightness); });
         o->t.inputs = parse_flag("--inputs", [&] { return parse_input_encoding(o->inputs); });
         if (given(*sub, "--outputs")) {

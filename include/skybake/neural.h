@@ -269,6 +269,20 @@ inline constexpr int kTrainingTargetSteps = 64;
 inline constexpr const char* kDefaultTopology = "shared:16x12";
 inline constexpr TableResolution kTrainingTargetTables{512, 256};
 
+// The training schedule measured for a topology's size (docs/neural.md,
+// "Training"), by its widest hidden layer: up to 16 wide 60 Adam epochs from
+// a step of 0.02 and 20 Levenberg–Marquardt iterations (the default); up to
+// 32, 60 epochs and 3 iterations; up to 64, 150 epochs from 0.01 and no LM
+// (the normal equations cost rows × P² and stop paying); wider, 30 epochs
+// from 0.005 (at 0.02 their outputs die). `sky train` and train_sky() use it
+// for whatever is not asked for.
+struct NeuralSchedule {
+    int adam_epochs = 60;
+    double learning_rate = 0.02;
+    int lm_iterations = 20;
+};
+NeuralSchedule training_schedule(const NeuralTopology& topology);
+
 struct NeuralTrainOptions {
     NeuralTopology topology;                 // its `outputs` is set from the encoding
     InputEncoding inputs = InputEncoding::Seed;

@@ -245,7 +245,8 @@ void bind_sky(py::module_& m) {
     m.def(
         "train_sky",
         [](Atmosphere atmosphere, const std::string& topology, const std::string& inputs,
-           std::optional<std::string> outputs, std::size_t samples, int adam_epochs, int lm_iterations,
+           std::optional<std::string> outputs, std::size_t samples, std::optional<int> adam_epochs,
+           std::optional<int> lm_iterations,
            std::uint64_t seed, const std::string& brightness, const std::string& table_rule, int steps,
            const std::string& device, std::optional<std::pair<double, double>> aerosol_range, double hard_share,
            std::optional<double> flight_share, const std::string& multiple_term, py::object progress) {
@@ -257,8 +258,10 @@ void bind_sky(py::module_& m) {
             o.topology = parse_topology(topology, "topology");
             o.samples = samples;
             o.heldout_samples = std::max<std::size_t>(1000, std::min<std::size_t>(20000, samples / 10));
-            o.adam_epochs = adam_epochs;
-            o.lm_iterations = lm_iterations;
+            const NeuralSchedule schedule = training_schedule(o.topology); // for what is not asked for
+            o.adam_epochs = adam_epochs.value_or(schedule.adam_epochs);
+            o.lm_iterations = lm_iterations.value_or(schedule.lm_iterations);
+            o.learning_rate = schedule.learning_rate;
             o.seed = seed;
             o.brightness = parse_brightness_encoding(brightness, "brightness");
             o.inputs = parse_input_encoding(inputs, "inputs");
@@ -282,7 +285,7 @@ void bind_sky(py::module_& m) {
             o.progress = true; // events go to the call's callback, never to a bar
             if (samples < 1000)
                 throw Error("at least 1000 training samples, got " + std::to_string(samples), "samples");
-            if (adam_epochs < 0 || lm_iterations < 0)
+            if (o.adam_epochs < 0 || o.lm_iterations < 0)
                 throw Error("epochs and iterations must be ≥ 0", "adam_epochs");
             SkyModelOptions targets;
             targets.steps = steps;
@@ -294,13 +297,14 @@ void bind_sky(py::module_& m) {
         },
         py::arg("atmosphere"), py::arg("topology") = kDefaultTopology, py::arg("inputs") = "horizon",
         py::arg("outputs") = py::none(), py::arg("samples") = 800000,
-        py::arg("adam_epochs") = 60, py::arg("lm_iterations") = 20, py::arg("seed") = 1,
+        py::arg("adam_epochs") = py::none(), py::arg("lm_iterations") = py::none(), py::arg("seed") = 1,
         py::arg("brightness") = "log", py::arg("table_rule") = "refined", py::arg("steps") = kTrainingTargetSteps,
         py::arg("device") = "cpu", py::arg("aerosol_range") = py::none(), py::arg("hard_share") = 0.0,
         py::arg("flight_share") = py::none(), py::arg("multiple_term") = "march", py::arg("progress") = py::none(),
         "Trains a network on the table path of `atmosphere` (Adam, then Levenberg–Marquardt), as "
         "`skybake sky train`: by default the best small network (shared:16x12, horizon inputs, residual "
-        "outputs, with multiple scattering too), targets from the refined 512 x 256 tables with 64 "
+        "outputs, with multiple scattering too), trained on the schedule measured for its size (training_schedule: "
+        "adam_epochs and lm_iterations None take it), targets from the refined 512 x 256 tables with 64 "
         "steps. aerosol_range=(min, max): one network for the family of atmospheres whose 'mie' amount is that "
         "multiple of the atmosphere's, chosen at run time (NeuralSky.aerosol). hard_share: the share of training "
         "samples drawn near the horizon, the sun and the terminator (importance sampling; 0 by default). "

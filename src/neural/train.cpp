@@ -432,6 +432,19 @@ double neural::effective_flight_share(const NeuralTrainOptions& o, const Atmosph
     return atmosphere.scattering == Scattering::Single ? 0.0 : kMultipleFlightShare;
 }
 
+NeuralSchedule training_schedule(const NeuralTopology& topology) {
+    int widest = 0;
+    for (int w : topology.hidden)
+        widest = std::max(widest, w);
+    if (widest <= 16)
+        return {60, 0.02, 20};
+    if (widest <= 32)
+        return {60, 0.02, 3};
+    if (widest <= 64)
+        return {150, 0.01, 0};
+    return {30, 0.005, 0};
+}
+
 OutputEncoding default_output_encoding(const Atmosphere& atmosphere) {
     NeuralEncoding e;
     e.outputs = OutputEncoding::Residual;
