@@ -61,40 +61,32 @@ TEST(NeuralCuda, GenericTopologiesMatchTheCpu) {
 
 TEST(NeuralCuda, EveryEncodingMatchesTheCpu) {
     SKYBAKE_SKIP_WITHOUT_GPU();
+    const auto compare = [](const NeuralSky& net, std::uint64_t seed, const std::string& what) {
+        const auto samples = draw_sky_samples(50000, seed);
+        std::vector<glm::vec3> cpu(samples.size()), gpu(samples.size());
+        evaluate_neural_sky(net, samples, cpu);
+        evaluate_neural_sky_cuda(net, samples, gpu);
+        SCOPED_TRACE(what);
+        expect_within_modelled_bound(net, samples, cpu, gpu);
+    };
     for (InputEncoding inputs : {InputEncoding::Seed, InputEncoding::Horizon})
         for (OutputEncoding outputs : {OutputEncoding::Radiance, OutputEncoding::PhaseFactored, OutputEncoding::Residual})
             for (const char* topology : {"paper", "shared:16x12"}) {
                 if (outputs != OutputEncoding::Radiance && std::string(topology) == "paper")
                     continue; // independent sub-networks have one output each: 6 of them here, not the seed's 4
-                const NeuralSky net = with_encoding(random_network(topology, 4), inputs, outputs, 12);
-                const auto samples = draw_sky_samples(50000, 21);
-                std::vector<glm::vec3> cpu(samples.size()), gpu(samples.size());
-                evaluate_neural_sky(net, samples, cpu);
-                evaluate_neural_sky_cuda(net, samples, gpu);
-                SCOPED_TRACE(std::string(topology) + ", " + input_encoding_name(inputs) + " / " +
-                             output_encoding_name(outputs));
-                expect_within_modelled_bound(net, samples, cpu, gpu);
+                compare(with_encoding(random_network(topology, 4), inputs, outputs, 12), 21,
+                        std::string(topology) + ", " + input_encoding_name(inputs) + " / " +
+                            output_encoding_name(outputs));
             }
-    {   // Multiple scattering, its term a correction of the isotropic march.
-        const NeuralSky marched = with_marched_multiple(with_encoding(
-            random_network("shared:16x12", 4), InputEncoding::Horizon, OutputEncoding::Residual, 12, true));
-        const auto samples = draw_sky_samples(50000, 23);
-        std::vector<glm::vec3> cpu(samples.size()), gpu(samples.size());
-        evaluate_neural_sky(marched, samples, cpu);
-        evaluate_neural_sky_cuda(marched, samples, gpu);
-        SCOPED_TRACE("shared:16x12, multiple scattering marched");
-        expect_within_modelled_bound(marched, samples, cpu, gpu);
-    }
+    // Multiple scattering, its term a correction of the isotropic march.
+    compare(with_marched_multiple(with_encoding(random_network("shared:16x12", 4), InputEncoding::Horizon,
+                                                OutputEncoding::Residual, 12, true)),
+            23, "shared:16x12, multiple scattering marched");
     // An aerosol family: the fifth input and the scaled, Chapman-view march.
-    const NeuralSky family = with_family(
-        with_encoding(random_network("shared:16x12", 4), InputEncoding::Horizon, OutputEncoding::Residual, 12), 1.0,
-        32.0, 9.0, 13);
-    const auto samples = draw_sky_samples(50000, 22);
-    std::vector<glm::vec3> cpu(samples.size()), gpu(samples.size());
-    evaluate_neural_sky(family, samples, cpu);
-    evaluate_neural_sky_cuda(family, samples, gpu);
-    SCOPED_TRACE("shared:16x12, aerosol family at 9");
-    expect_within_modelled_bound(family, samples, cpu, gpu);
+    compare(with_family(with_encoding(random_network("shared:16x12", 4), InputEncoding::Horizon,
+                                      OutputEncoding::Residual, 12),
+                        1.0, 32.0, 9.0, 13),
+            22, "shared:16x12, aerosol family at 9");
 }
 
 TEST(NeuralCuda, ThroughputChecksumEqualsTheCpus) {

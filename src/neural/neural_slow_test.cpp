@@ -111,16 +111,21 @@ NeuralSky train_the_default(Scattering scattering, double aerosol_max = 1.0) {
     return train_neural_sky(SkyModel(atm, so), o);
 }
 
-// The targets of a network of at most 400 weights: 5% over the lit samples
-// and 15% at twilight, on the held-out samples and on a flight's, and views
-// of 35 dB mean, 30 dB at worst.
-void expect_small_network_targets(const NeuralErrorReport& r) {
-    EXPECT_LT(r.all.mean, 0.05);
-    EXPECT_LT(r.twilight.mean, 0.15);
+// The targets of a network of at most 400 weights on a flight's samples (5%
+// over the lit ones, 15% at twilight) and in the views (35 dB mean, 30 dB at
+// worst).
+void expect_small_network_flight_targets(const NeuralErrorReport& r) {
     EXPECT_LT(r.flight_all.mean, 0.05);
     EXPECT_LT(r.flight_twilight.mean, 0.15);
     EXPECT_GT(r.mean_view_psnr_db, 35.0);
     EXPECT_GT(r.min_view_psnr_db, 30.0);
+}
+
+// And the same on the held-out samples.
+void expect_small_network_targets(const NeuralErrorReport& r) {
+    EXPECT_LT(r.all.mean, 0.05);
+    EXPECT_LT(r.twilight.mean, 0.15);
+    expect_small_network_flight_targets(r);
 }
 
 } // namespace
@@ -157,13 +162,12 @@ TEST(NeuralSlow, TheDefaultSmallNetworkOfTheWholeSkysLight) {
     // 12.0%, flight 4.36% (day 2.77%, twilight 11.6%), views 42.79 / 31.57
     // dB; the log-encoded term had flight 20.7% (twilight 53.2%), 39.0 /
     // 31.0 dB. Bounds: the targets of at most 400 weights on the flight and
-    // the views, and 1.3x the day.
+    // the views, the twilight's on the held-out samples (whose mean over
+    // every lit sample, down to midnight's sky, is not met: 7.4%), and 1.3x
+    // the day.
     EXPECT_LT(r.day.mean, 0.036);
     EXPECT_LT(r.twilight.mean, 0.15);
-    EXPECT_LT(r.flight_all.mean, 0.05);
-    EXPECT_LT(r.flight_twilight.mean, 0.15);
-    EXPECT_GT(r.mean_view_psnr_db, 35.0);
-    EXPECT_GT(r.min_view_psnr_db, 30.0);
+    expect_small_network_flight_targets(r);
 }
 
 TEST(NeuralSlow, TheDefaultSmallNetworkOfAnAerosolFamily) {
