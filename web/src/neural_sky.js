@@ -146,7 +146,8 @@ export class NeuralSky {
         fail(`encoding.multiple_psi needs multiple_max and log_psi: 3 rows of ${PSI_COEFFICIENTS} coefficients`);
       const muMin = finiteNumber(e.multiple_psi.mu_s_min, 'encoding.multiple_psi.mu_s_min');
       if (!(muMin >= -0.99 && muMin <= 0.5)) fail('encoding.multiple_psi.mu_s_min must be in [-0.99, 0.5]');
-      this.psi = { muMin: f(muMin), a: rows.map((row) => Float32Array.from(row, (x) => finiteNumber(x, 'log_psi'))) };
+      const coefficient = (x) => (Math.abs(finiteNumber(x, 'log_psi')) <= 1e4 ? x : fail('log_psi must be numbers in [-1e4, 1e4]'));
+      this.psi = { muMin: f(muMin), a: rows.map((row) => Float32Array.from(row, coefficient)) };
     }
     const outputs = factored ? 3 * this.terms.length + (this.multipleMax ? 3 : 0) : 4;
     // An aerosol family: the amount of one component is a fifth input, set at

@@ -105,6 +105,15 @@ test('a file that is not a weights file is one clear error', () => {
   assert.throws(() => new NeuralSky(broken), /each sub-network has 40 weights/);
 });
 
+test('a marched multiple-scattering term with a bad psi is one clear error, as in the library', { skip: !data ? 'SKYBAKE_TEST_DATA not set' : false }, () => {
+  const good = JSON.parse(readFileSync(join(data, 'neural', 'v3_earth_multiple_march.json'), 'utf8'));
+  const bad = (edit) => { const d = structuredClone(good); edit(d.encoding); return d; };
+  assert.throws(() => new NeuralSky(bad((e) => { e.multiple_psi.log_psi[1][3] = 1e9; })), /log_psi must be numbers in \[-1e4, 1e4\]/);
+  assert.throws(() => new NeuralSky(bad((e) => { e.multiple_psi.log_psi.pop(); })), /3 rows of 21 coefficients/);
+  assert.throws(() => new NeuralSky(bad((e) => { e.multiple_psi.mu_s_min = 0.9; })), /mu_s_min must be in/);
+  assert.throws(() => new NeuralSky(bad((e) => { delete e.multiple_max; })), /needs multiple_max/);
+});
+
 test('the shared test vectors: the library\'s scalar pass to 1e-5 relative', { skip: !data ? 'SKYBAKE_TEST_DATA not set' : false }, () => {
   const doc = JSON.parse(readFileSync(join(data, 'neural', 'test_vectors.json'), 'utf8'));
   assert.equal(doc.format, 'skybake-neural-test-vectors');
