@@ -491,7 +491,7 @@ MarchConstants emit_analytic_terms(std::ostringstream& o, const std::string& nam
     return {R0, top, scale, H, be, bs};
 }
 
-// mlp_hd.h's analytic_multiple (multiple_steps and psi_log), operation for
+// mlp_hd.h's analytic_multiple_along (and psi_log), operation for
 // operation, into M_r, M_g, M_b; ψ's constants from `constant`.
 void emit_analytic_multiple(std::ostringstream& o, const MlpHD& m, const Dialect& d, const MarchConstants& mc,
                             const Constant& constant) {

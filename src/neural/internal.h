@@ -158,7 +158,6 @@ Atmosphere scaled_atmosphere(const NeuralEncoding& family, const Atmosphere& atm
 // Network inputs (m.width[0] × n) from samples, through the input encoding of
 // m; `aerosol`, when not empty, holds each sample's aerosol amount (a family).
 MatF samples_to_matrix(const MlpHD& m, std::span<const SkySample> samples, std::span<const float> aerosol = {});
-// analytic_terms (3 per term × n) of the samples.
 // NeuralTrainOptions::flight_share, with its automatic value resolved.
 constexpr double kMultipleFlightShare = 0.3;
 double effective_flight_share(const NeuralTrainOptions& options, const Atmosphere& atmosphere);
@@ -168,6 +167,8 @@ double effective_flight_share(const NeuralTrainOptions& options, const Atmospher
 // mean radiance over the sphere, at altitudes from the ground to the top and
 // sun cosines from mu_s_min to 1.
 std::vector<double> fit_multiple_psi(const SkyModel& model, double mu_s_min, Device device);
+// analytic_base of the samples: 3 per term, and 3 more for a marched
+// multiple-scattering term, × n.
 MatF analytic_matrix(const MlpHD& m, std::span<const SkySample> samples, std::span<const float> aerosol = {});
 // evaluate_neural_sky with each sample's own aerosol amount (empty: net.aerosol).
 void evaluate_neural_sky_at(const NeuralSky& net, std::span<const SkySample> samples, std::span<const float> aerosol,

@@ -351,13 +351,10 @@ SKYBAKE_HD_INLINE bool misses_atmosphere(const MlpHD& m, float cos_view_zenith, 
 // Chapman integral (chapman_segment) where the part spans scale heights, so
 // that a steep profile (aerosols, a 1.2 km scale height, on a 100 km ray) is
 // not lost between the steps.
-SKYBAKE_HD_INLINE void analytic_terms(const MlpHD& m, float cos_view_zenith, float cos_view_sun, float cos_sun_zenith,
-                                      float density, float* base) {
-    for (int i = 0; i < 3 * m.terms; ++i)
-        base[i] = 0.0f;
-    if (misses_atmosphere(m, cos_view_zenith, density))
-        return;
-    const ViewRayHD v = view_ray_precise(m, cos_view_zenith, density);
+// analytic_terms along the view ray v (view_ray_precise), adding into base,
+// which the caller has zeroed.
+SKYBAKE_HD_INLINE void analytic_terms_along(const MlpHD& m, const ViewRayHD& v, float cos_view_zenith,
+                                            float cos_view_sun, float cos_sun_zenith, float* base) {
     // The family's aerosol amount scales its component's coefficients.
     float ext_beta[kMaxTerms][3], term_beta[kMaxTerms][3];
     for (int e = 0; e < m.ext_count; ++e)
@@ -447,6 +444,16 @@ SKYBAKE_HD_INLINE void analytic_terms(const MlpHD& m, float cos_view_zenith, flo
     }
 }
 
+SKYBAKE_HD_INLINE void analytic_terms(const MlpHD& m, float cos_view_zenith, float cos_view_sun, float cos_sun_zenith,
+                                      float density, float* base) {
+    for (int i = 0; i < 3 * m.terms; ++i)
+        base[i] = 0.0f;
+    if (misses_atmosphere(m, cos_view_zenith, density))
+        return;
+    analytic_terms_along(m, view_ray_precise(m, cos_view_zenith, density), cos_view_zenith, cos_view_sun,
+                         cos_sun_zenith, base);
+}
+
 // [SECTION] Residual outputs' multiple-scattering term: an isotropic march
 //
 // Hillaire 2020's approximation of the light scattered more than once: every
@@ -476,15 +483,11 @@ SKYBAKE_HD_INLINE float psi_log(const MlpHD& m, int c, float h, float mu_s) {
     return acc;
 }
 
-// The march's steps: each step k's weight w[k][c] = σs dt e^(−τ) (1 −
-// e^(−Δτ))/Δτ per channel, and its midpoint's altitude h[k] and sun cosine
-// mu_s[k]. False (and no steps) where the ray sees no air.
-SKYBAKE_HD_INLINE bool multiple_steps(const MlpHD& m, float cos_view_zenith, float cos_view_sun, float cos_sun_zenith,
-                                      float density, float w[kMultipleSteps][3], float h[kMultipleSteps],
-                                      float mu_s[kMultipleSteps]) {
-    if (misses_atmosphere(m, cos_view_zenith, density))
-        return false;
-    const ViewRayHD v = view_ray_precise(m, cos_view_zenith, density);
+// The march M = Σ_k w_k ψ(h_k, μs_k) per channel along the view ray v
+// (view_ray_precise), w_k = σs dt e^(−τ) (1 − e^(−Δτ))/Δτ at step k's
+// midpoint, adding into out[0..2], which the caller has zeroed.
+SKYBAKE_HD_INLINE void analytic_multiple_along(const MlpHD& m, const ViewRayHD& v, float cos_view_zenith,
+                                               float cos_view_sun, float cos_sun_zenith, float* out) {
     const float rho2 = v.rho * v.rho, two_r_mu = 2.0f * v.r * cos_view_zenith;
     const float dt = v.d * (1.0f / float(kMultipleSteps));
     float prev[kMaxTerms], tau[3] = {0.0f, 0.0f, 0.0f};
@@ -498,8 +501,7 @@ SKYBAKE_HD_INLINE bool multiple_steps(const MlpHD& m, float cos_view_zenith, flo
             q = q > 0.0f ? q : 0.0f;
             hp[j] = q / (sqrtf(q + m.R0 * m.R0) + m.R0);
         }
-        h[k] = hp[0];
-        mu_s[k] = (v.r * cos_sun_zenith + (float(k) + 0.5f) * dt * cos_view_sun) / (m.R0 + hp[0]);
+        const float mu_s = (v.r * cos_sun_zenith + (float(k) + 0.5f) * dt * cos_view_sun) / (m.R0 + hp[0]);
         float mid[kMaxTerms], end[kMaxTerms];
         for (int e = 0; e < m.ext_count; ++e) {
             mid[e] = expf(-hp[0] / m.ext_height[e]);
@@ -515,35 +517,38 @@ SKYBAKE_HD_INLINE bool multiple_steps(const MlpHD& m, float cos_view_zenith, flo
             // (shaders' exp is a few ulp off; 1/Δτ would magnify that).
             const float f = dtau > 0.1f ? (1.0f - expf(-dtau)) / dtau
                                         : 1.0f - dtau * (0.5f - dtau * (0.166666672f - dtau * 0.0416666679f));
-            w[k][c] = expf(-tau[c]) * sca * dt * f;
+            const float w = expf(-tau[c]) * sca * dt * f;
             tau[c] += dtau;
+            out[c] += w * expf(psi_log(m, c, hp[0], mu_s));
         }
         for (int e = 0; e < m.ext_count; ++e)
             prev[e] = end[e];
     }
-    return true;
 }
 
-// The march M = Σ_k w[k] ψ(h[k], mu_s[k]) per channel (1/sr per unit sun
-// irradiance) into out[0..2].
+// The march M per channel (1/sr per unit sun irradiance) into out[0..2].
 SKYBAKE_HD_INLINE void analytic_multiple(const MlpHD& m, float cos_view_zenith, float cos_view_sun,
                                          float cos_sun_zenith, float density, float* out) {
-    float w[kMultipleSteps][3], h[kMultipleSteps], mu_s[kMultipleSteps];
     out[0] = out[1] = out[2] = 0.0f;
-    if (!multiple_steps(m, cos_view_zenith, cos_view_sun, cos_sun_zenith, density, w, h, mu_s))
+    if (misses_atmosphere(m, cos_view_zenith, density))
         return;
-    for (int k = 0; k < kMultipleSteps; ++k)
-        for (int c = 0; c < 3; ++c)
-            out[c] += w[k][c] * expf(psi_log(m, c, h[k], mu_s[k]));
+    analytic_multiple_along(m, view_ray_precise(m, cos_view_zenith, density), cos_view_zenith, cos_view_sun,
+                            cos_sun_zenith, out);
 }
 
 // The residual outputs' analytic parts: analytic_terms into base[0, 3 terms),
 // and for a multiple-scattering term marched, analytic_multiple after them.
 SKYBAKE_HD_INLINE void analytic_base(const MlpHD& m, float cos_view_zenith, float cos_view_sun, float cos_sun_zenith,
                                      float density, float* base) {
-    analytic_terms(m, cos_view_zenith, cos_view_sun, cos_sun_zenith, density, base);
-    if (m.multiple && m.multiple_march)
-        analytic_multiple(m, cos_view_zenith, cos_view_sun, cos_sun_zenith, density, base + 3 * m.terms);
+    const bool marched = m.multiple && m.multiple_march;
+    for (int i = 0; i < 3 * m.terms + (marched ? 3 : 0); ++i)
+        base[i] = 0.0f;
+    if (misses_atmosphere(m, cos_view_zenith, density))
+        return;
+    const ViewRayHD v = view_ray_precise(m, cos_view_zenith, density); // once for both marches
+    analytic_terms_along(m, v, cos_view_zenith, cos_view_sun, cos_sun_zenith, base);
+    if (marched)
+        analytic_multiple_along(m, v, cos_view_zenith, cos_view_sun, cos_sun_zenith, base + 3 * m.terms);
 }
 
 // Encoded value -> [0, ...): (x − 0.05)/0.9, values below 0.05 are 0.

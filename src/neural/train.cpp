@@ -152,18 +152,18 @@ TrainingData neural::make_training_data(const SkyModel& model, const NeuralEncod
                                         double flight_share) {
     DataSet d;
     std::vector<SkySample> s = draw_sky_samples(n, seed);
-    if (hard_share > 0.0) { // every k-th sample from where the sky is hard
-        const std::size_t hard = std::size_t(std::llround(hard_share * double(n)));
-        const std::vector<SkySample> h = draw_hard_samples(hard, seed ^ 0x4a4d4a4dull, model.atmosphere());
-        for (std::size_t j = 0; j < hard; ++j)
-            s[std::min(n - 1, std::size_t(double(j) / hard_share))] = h[j];
-    }
-    if (flight_share > 0.0) { // then every k-th sample from a flight's (draw_flight_samples)
-        const std::size_t k = std::size_t(std::llround(flight_share * double(n)));
-        const std::vector<SkySample> f = draw_flight_samples(k, seed ^ 0x5151f11eull, model.atmosphere());
+    // A share of the samples replaced by others, spread evenly: every k-th.
+    const auto replace_share = [&](double share, auto draw) {
+        const std::size_t k = std::size_t(std::llround(share * double(n)));
+        const std::vector<SkySample> other = draw(k);
         for (std::size_t j = 0; j < k; ++j)
-            s[std::min(n - 1, std::size_t(double(j) / flight_share))] = f[j];
-    }
+            s[std::min(n - 1, std::size_t(double(j) / share))] = other[j];
+    };
+    if (hard_share > 0.0) // where the sky is hard
+        replace_share(hard_share, [&](std::size_t k) { return draw_hard_samples(k, seed ^ 0x4a4d4a4dull, model.atmosphere()); });
+    if (flight_share > 0.0) // then a flight's (draw_flight_samples)
+        replace_share(flight_share,
+                      [&](std::size_t k) { return draw_flight_samples(k, seed ^ 0x5151f11eull, model.atmosphere()); });
     MlpHD hd;
     set_encoding_hd(enc, model.atmosphere(), hd);
     hd.width[0] = enc.input_count();
