@@ -389,15 +389,20 @@ double track(const M& m, const glm::dvec3& x, const glm::dvec3& d, double t0, do
     }
 }
 
-// Survives with probability β / kRouletteWeight when β is below it.
-bool roulette(double& beta, SplitMix64& rng) {
-    if (beta >= kRouletteWeight)
+// Survives with probability β / (kRouletteWeight β0) when β is below
+// kRouletteWeight β0, β0 the weight the path started with: the forced first
+// collision in a thin view ray starts paths at its collision probability
+// (1e-3 for the zenith from 50 km), and a roulette against an absolute
+// weight ended all but a few of them there.
+bool roulette(double& beta, double beta0, SplitMix64& rng) {
+    const double floor = kRouletteWeight * beta0;
+    if (beta >= floor)
         return true;
     if (!(beta > 0.0))
         return false;
-    if (rng.uniform() * kRouletteWeight >= beta)
+    if (rng.uniform() * floor >= beta)
         return false;
-    beta = kRouletteWeight;
+    beta = floor;
     return true;
 }
 
@@ -437,6 +442,7 @@ double trace_path(const M& m, const PrimaryRay& ray, const PathTracerOptions& op
                          kUniformShare / (ray.exit - ray.enter);
         beta = analog / q;
     }
+    const double beta0 = beta;
     int order = 0;
     for (;;) {
         // A real collision at x, arriving along d.
@@ -493,7 +499,7 @@ double trace_path(const M& m, const PrimaryRay& ray, const PathTracerOptions& op
         d = next;
         if (sunlit && counted(order + 1))
             L += beta * m.sunlit_air(x, d, true);
-        if (!roulette(beta, rng))
+        if (!roulette(beta, beta0, rng))
             return L;
 
         // Flights (and ground bounces) until the next collision in the medium.
@@ -524,7 +530,7 @@ double trace_path(const M& m, const PrimaryRay& ray, const PathTracerOptions& op
             d = around(n, std::sqrt(u1), 2.0 * kPi * rng.uniform());
             if (sunlit && counted(order + 1) && beta > 0.0)
                 L += beta * m.sunlit_air(x, d, true);
-            if (!roulette(beta, rng))
+            if (!roulette(beta, beta0, rng))
                 return L;
         }
     }

@@ -291,6 +291,27 @@ TEST(PathTracerSunlitAir, ResolvesTheSkyBeyondTheTerminator) {
     }
 }
 
+TEST(PathTracerSunlitAir, FindsTheThirdOrderHighUp) {
+    // The zenith from 50 km, the sun 8° below the horizon: the view ray's
+    // collision probability is 1e-3, and paths start with that weight. A
+    // roulette against an absolute weight ended all but 0.4% of them at
+    // their first collision, and out of 2^14 paths the third order came
+    // from one or none (0 in green). Against the path's own starting
+    // weight, most paths reach it.
+    const Atmosphere atm = atmosphere_preset("earth");
+    const double mu_s = std::cos(98.0 * kPi / 180.0);
+    PathTracerOptions opt;
+    opt.min_order = 3;
+    opt.max_order = 3;
+    opt.paths = 1u << 14;
+    opt.next_event = NextEvent::SunlitAir;
+    const PathTracedRadiance m = path_trace_sky(atm, atm.planet_radius_km + 50.0, 1.0, mu_s, mu_s, opt);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_GT(m.mean[c], 0.0) << "channel " << c;
+        EXPECT_LT(3.0 * m.standard_error[c], 0.6 * m.mean[c]) << "channel " << c;
+    }
+}
+
 TEST(PathTracer, BadInputNamesTheField) {
     const Atmosphere atm = atmosphere_preset("earth");
     const double r = atm.planet_radius_km;
