@@ -4,8 +4,8 @@
 // horizon towards and away from the sun (docs/sky.md, "Error over a grid of
 // views", is this program's output).
 //
-//   twilight_report [--paths N] [--twilight-paths N] [--reference FILE] [--nmus N] [--mu-s-min C] [--sphere N] [--nu N] [--orders N]
-//   twilight_report --night [--twilight-paths N] [--nmus N] [--mu-s-min C] [--orders N]
+//   twilight_report [--paths N] [--twilight-paths N] [--reference FILE] [--nr N] [--nmus N] [--mu-s-min C] [--sphere N] [--nu N] [--orders N]
+//   twilight_report --night [--twilight-paths N] [--nr N] [--nmus N] [--mu-s-min C] [--orders N]
 //   (--altitude H and --sun S keep only the views at H km, at S°)
 //
 // The reference is the exact single-scattering quadrature plus the path
@@ -119,6 +119,8 @@ int main(int argc, char** argv) {
             reference_file = value;
         else if (a == "--nmus")
             res.mu_s = std::atoi(value);
+        else if (a == "--nr")
+            res.r = std::atoi(value);
         else if (a == "--sphere")
             res.sphere = std::atoi(value);
         else if (a == "--nu")

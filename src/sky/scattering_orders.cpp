@@ -152,6 +152,25 @@ glm::dvec3 irradiance_lookup(const std::vector<glm::dvec3>& e, double mu_s) {
     return (1.0 - f) * e[std::size_t(i)] + f * e[std::size_t(i) + 1];
 }
 
+} // namespace
+
+double orders_scale(const Atmosphere& atm, double r, double mu) {
+    const double R0 = atm.planet_radius_km;
+    r = std::clamp(r, R0, atm.top_radius_km);
+    if (mu < 0.0 && r * r * (mu * mu - 1.0) + R0 * R0 >= 0.0)
+        return 1.0; // the ray meets the ground
+    const double lowest = mu >= 0.0 ? r - R0 : std::max(0.0, r * std::sqrt(std::max(0.0, 1.0 - mu * mu)) - R0);
+    double at = 0.0, ground = 0.0;
+    for (const AtmosphereComponent& c : atm.components) {
+        const double w = c.scattering_per_km.x + c.scattering_per_km.y + c.scattering_per_km.z;
+        at += w * relative_density(c, lowest);
+        ground += w * relative_density(c, 0.0);
+    }
+    return ground > 0.0 ? std::max(at / ground, 1e-30) : 1.0;
+}
+
+namespace {
+
 // The sun direction in the frame where the view ω = (sin, 0, μ).
 glm::dvec3 sun_in_view_frame(double mu, double mu_s, double nu) {
     const double s = std::sqrt(std::max(0.0, 1.0 - mu * mu));
@@ -263,6 +282,9 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
                 for (std::size_t k = 0; k < K; ++k)
                     single[idx * K + k] += atm.components[k].scattering_per_km * relative_density(atm.components[k], rt - R0) * w;
             });
+            const double f = orders_scale(atm, r, mu);
+            for (std::size_t k = 0; k < K; ++k)
+                single[idx * K + k] /= f;
         }
         advance(e - b);
     });
@@ -270,15 +292,17 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
     // Radiance and ground irradiance of the previous order.
     std::vector<glm::dvec3> prev;      // order n − 1 ≥ 2
     std::vector<glm::dvec3> prev_irr;  // E_{n−1} for n − 1 ≥ 2
-    const auto incident = [&](int order, const Taps& tp, double nu_i) {
+    // The grids hold radiance per unit of orders_scale(r, μ) (scale: its value
+    // where the look-up is).
+    const auto incident = [&](int order, const Taps& tp, double nu_i, double scale) {
         if (order == 1) {
             glm::dvec3 s(0.0);
             for (std::size_t k = 0; k < K; ++k)
                 if (atm.components[k].phase != PhaseFunction::None)
                     s += phase(k, nu_i) * apply_taps(tp, single, K, k);
-            return s;
+            return s * scale;
         }
-        return apply_taps(tp, prev);
+        return apply_taps(tp, prev) * scale;
     };
     const auto ground_irradiance = [&](int order, double mu_s) {
         if (order == 1)
@@ -286,6 +310,17 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
         return irradiance_lookup(prev_irr, mu_s);
     };
 
+    // The air's scattering coefficient at radius r (per channel), floored:
+    // J is stored per unit of it (J / σs), which is smooth in altitude where
+    // J itself falls with the density, e-fold by e-fold between the radius
+    // nodes (7 km apart at the top, about one scale height): interpolated
+    // linearly, J was up to 12% too large between them.
+    const auto scattering_at = [&](double r) {
+        glm::dvec3 s(0.0);
+        for (std::size_t k = 0; k < K; ++k)
+            s += atm.components[k].scattering_per_km * relative_density(atm.components[k], r - R0);
+        return glm::max(s, glm::dvec3(1e-30));
+    };
     std::vector<float> residual(N * 3, 0.0f);
     std::vector<glm::dvec3> sum(N, glm::dvec3(0.0));
     if (keep_orders) {
@@ -302,6 +337,7 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
             std::vector<char> hits(D);
             std::vector<Grid4Coord<double>> at(D); // the (r, μ_i) axes of each direction
             std::vector<Axis> ar(D), am(D);
+            std::vector<double> scale_i(D);
             for (std::size_t ray = b; ray < e; ++ray) {
                 double r, mu, mu_s, nu;
                 bool ground;
@@ -320,6 +356,7 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
                     at[i] = g.coordinates(r, wi.z, 1.0, 0.0);
                     ar[i] = axis(at[i].xr, g.nr);
                     am[i] = axis(at[i].xmu, g.nmu);
+                    scale_i[i] = orders_scale(atm, r, wi.z);
                     const double dg = ray_ground_distance(R0, r, wi.z);
                     hits[i] = dg >= 0.0;
                     if (hits[i]) {
@@ -340,12 +377,12 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
                         const glm::dvec3& wi = sphere.dir[i];
                         const double nu_i = glm::dot(sun, wi);
                         const Axis an = axis(hd_clamp((nu_i + 1.0) * 0.5, 0.0, 1.0), g.nnu);
-                        glm::dvec3 L = incident(n - 1, taps(g, at[i].ground, ar[i], am[i], as, an), nu_i);
+                        glm::dvec3 L = incident(n - 1, taps(g, at[i].ground, ar[i], am[i], as, an), nu_i, scale_i[i]);
                         if (hits[i])
                             L += to_ground[i] * ground_irradiance(n - 1, glm::dot(ground_point[i], sun));
                         j += weight[i] * L;
                     }
-                    J[idx] = j;
+                    J[idx] = j / scattering_at(r);
                 }
             }
         });
@@ -360,7 +397,8 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
                 if (wi.z <= 0.0)
                     continue;
                 const double nu_i = glm::dot(sun, wi);
-                e += incident(n - 1, taps(g, g.coordinates(R0, wi.z, mu_s, nu_i)), nu_i) * (wi.z * ground_rule.weight[i]);
+                e += incident(n - 1, taps(g, g.coordinates(R0, wi.z, mu_s, nu_i)), nu_i, orders_scale(atm, R0, wi.z)) *
+                     (wi.z * ground_rule.weight[i]);
             }
             irr[std::size_t(m)] = e;
         }
@@ -376,8 +414,10 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
                     const double rt = std::max(R0, ray_radius(r, mu, t));
                     const double mut = std::clamp((r * mu + t) / rt, -1.0, 1.0);
                     const double must = std::clamp((r * mu_s + t * nu) / rt, -1.0, 1.0);
-                    s += T.between(r, mu, t, ground) * apply_taps(taps(g, g.coordinates(rt, mut, must, nu)), J) * dt;
+                    s += T.between(r, mu, t, ground) * scattering_at(rt) *
+                         apply_taps(taps(g, g.coordinates(rt, mut, must, nu)), J) * dt;
                 });
+                s /= orders_scale(atm, r, mu);
                 cur[idx] = s;
                 sum[idx] += s;
             }
@@ -400,8 +440,9 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
 glm::dvec3 ScatteringOrders::order_radiance(int n, double r, double mu, double mu_s, double nu) const {
     assert(n >= 1 && n <= orders_ && !single_.empty());
     const Taps tp = taps(shape_, shape_.coordinates(r, mu, mu_s, nu));
+    const double scale = orders_scale(atmosphere_, r, mu);
     if (n >= 2)
-        return apply_taps(tp, multiple_[std::size_t(n - 2)]);
+        return apply_taps(tp, multiple_[std::size_t(n - 2)]) * scale;
     const std::size_t K = atmosphere_.components.size();
     glm::dvec3 s(0.0);
     for (std::size_t k = 0; k < K; ++k) {
@@ -409,7 +450,7 @@ glm::dvec3 ScatteringOrders::order_radiance(int n, double r, double mu, double m
         if (a.phase != PhaseFunction::None)
             s += phase_function(a.phase, a.phase_g, nu) * apply_taps(tp, single_, K, k);
     }
-    return s;
+    return s * scale;
 }
 
 glm::dvec3 ScatteringOrders::ground_irradiance(int n, double mu_s) const {

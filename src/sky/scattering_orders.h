@@ -32,6 +32,15 @@ struct Grid4Shape {
     }
 };
 
+// What the orders' grids are stored per unit of, at radius r along cosine μ:
+// the air's scattering (summed over the channels) at the ray's lowest point,
+// relative to the ground's; 1 for a ray that meets the ground. Looking up
+// or along from high up, the light of the scattering orders falls with the
+// air's density, an e-fold between radius nodes near the top (7 km apart
+// there); per unit of it, the grids interpolate linearly without the 7–10%
+// excess between nodes. The run-time twin: orders_scale in sky_shared.h.
+double orders_scale(const Atmosphere& atmosphere, double r, double mu);
+
 class ScatteringOrders {
 public:
     // Orders 1..orders (orders ≥ 2). keep_orders: keep each order's grid for

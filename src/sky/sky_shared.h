@@ -540,6 +540,30 @@ SKYBAKE_HD_INLINE vec3 orders_lookup(SB_IN(MultipleHD) m, float R0, float Rt, fl
                 grid4_mus_blend(at[0].z, at[1].z, fs, below));
 }
 
+// What the orders grid is stored per unit of (the twin of
+// sky::orders_scale in scattering_orders.h): the air's scattering, summed
+// over the channels, at the lowest point of a ray that does not meet the
+// ground, relative to the ground's; 1 for a ray that meets it.
+SKYBAKE_HD_INLINE float orders_scale(SB_IN(AtmosphereHD) a, float r, float mu) {
+    r = hd_clamp(r, a.R0, a.Rtop);
+    if (mu < 0.0f && r * r * (mu * mu - 1.0f) + a.R0 * a.R0 >= 0.0f)
+        return 1.0f;
+    float lowest = mu >= 0.0f ? r - a.R0 : fmaxf(r * hd_sqrt(1.0f - mu * mu) - a.R0, 0.0f);
+    float at = 0.0f;
+    float ground = 0.0f;
+    for (int k = 0; k < a.count; ++k) {
+        float w = a.comp[k].sca.x + a.comp[k].sca.y + a.comp[k].sca.z;
+        at += w * component_density(a.comp[k], lowest);
+        ground += w * component_density(a.comp[k], 0.0f);
+    }
+    return ground > 0.0f ? fmaxf(at / ground, 1e-30f) : 1.0f;
+}
+
+// The light of orders ≥ 2 from the grid (orders_lookup) at radius r along (μ, μs, ν).
+SKYBAKE_HD_INLINE vec3 orders_radiance(SB_IN(AtmosphereHD) a, float r, float mu, float mu_s, float nu) {
+    return orders_scale(a, r, mu) * orders_lookup(a.ms, a.R0, a.Rtop, r, mu, mu_s, nu);
+}
+
 // Bilinear look-up in an RGB table over altitude (uniform, ground to top) and
 // sun cosine (uniform in [−1, 1]).
 SKYBAKE_HD_INLINE vec3 altitude_sun_lookup(SB_DATA t, int nr, int nmus, float R0, float Rt, float h, float mu_s) {
@@ -596,13 +620,13 @@ SKYBAKE_HD_INLINE vec3 multiple_residual_to(SB_IN(AtmosphereHD) a, ObserverHD o,
     if (a.ms.method == kMultipleNone || !enter_atmosphere(a, e))
         return result;
     if (a.ms.method == kMultipleOrders) {
-        result = orders_lookup(a.ms, a.R0, a.Rtop, e.r, e.cv, e.cs, e.cvs);
+        result = orders_radiance(a, e.r, e.cv, e.cs, e.cvs);
         if (limit >= 0.0f) {
             float rp = sqrtf(fmaxf(o.r * o.r + limit * limit + 2.0f * o.r * limit * o.cv, 0.0f));
             float mup = hd_clamp((o.r * o.cv + limit) / rp, -1.0f, 1.0f);
             float musp = hd_clamp((o.r * o.cs + limit * o.cvs) / rp, -1.0f, 1.0f);
             vec3 t = segment_transmittance(a, e.r, e.h, e.cv, rp, rp - a.R0, mup);
-            result = max(result - t * orders_lookup(a.ms, a.R0, a.Rtop, rp, mup, musp, o.cvs), vec3(0.0f));
+            result = max(result - t * orders_radiance(a, rp, mup, musp, o.cvs), vec3(0.0f));
         }
         return result;
     }

@@ -28,7 +28,7 @@ namespace skybake::sky {
 
 // Bump whenever the file layout or the tables' algorithms change (results of
 // an older build must not be read back as this build's).
-inline constexpr unsigned kTableCacheFormat = 3; // 2: orders interpolated geometrically in μs below the horizon; 3: the sphere rule split at the geometric horizon and the horizontal
+inline constexpr unsigned kTableCacheFormat = 4; // 2: orders interpolated geometrically in μs below the horizon; 3: the sphere rule split at the geometric horizon and the horizontal; 4: J interpolated per unit scattering coefficient
 
 struct CachedTables {
     std::vector<float> main;       // MultipleHD::orders or MultipleHD::psi
