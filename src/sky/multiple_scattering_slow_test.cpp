@@ -161,8 +161,8 @@ glm::dvec3 direct_second_order_zenith(const Atmosphere& atm, double mu_s, double
 }
 
 // At night the orders' second order at the zenith (default grid) follows the
-// direct integral: measured 0.95, 0.96, 0.91 of it at −12° and 0.90, 1.03,
-// 0.87 at −16° (R, G, B). At −16° the path tracer's second order (next
+// direct integral: measured 0.97, 0.98, 0.94 of it at −12° and 0.94, 1.09,
+// 0.93 at −16° (R, G, B). At −16° the path tracer's second order (next
 // events through the sunlit air, 2^15 paths) agrees with the direct
 // integral too: 2.8e-10, 6.0e-11, 1.3e-10 (three standard errors 11–19%)
 // against 2.9e-10, 5.4e-11, 1.2e-10. The former sphere rule (split at the

@@ -12,6 +12,7 @@
 #include "skybake/sky.h"
 #include "sky/internal.h"
 #include "sky/scattering_orders.h"
+#include "sky/sky_hd.h"
 
 namespace skybake {
 namespace {
@@ -157,6 +158,39 @@ TEST_F(ScatteringOrdersEarth, GroundIrradianceDecreases) {
 
 // In an optically thin atmosphere the second order is much smaller than the
 // first: the ratio scales with the optical depth.
+// The grid's stored unit, in double (the precomputation) and in float (every
+// look-up: sky_shared.h, shared with CUDA and GLSL): the same function,
+// including rays that meet the ground (1), rays that pass below the
+// horizontal, and a scatterer with a tent profile.
+TEST(OrdersGrid, ScaleHasItsFloatTwin) {
+    Atmosphere atm = atmosphere_preset("earth");
+    AtmosphereComponent tent;
+    tent.name = "tent haze";
+    tent.profile = DensityProfile::Tent;
+    tent.tent_center_km = 20.0;
+    tent.tent_half_width_km = 10.0;
+    tent.scattering_per_km = glm::dvec3(0.002);
+    tent.extinction_per_km = glm::dvec3(0.002);
+    tent.phase = PhaseFunction::Rayleigh;
+    atm.components.push_back(tent);
+    for (const Atmosphere& a : {atmosphere_preset("earth"), atm}) {
+        const SkyModel model(a);
+        const sky::AtmosphereHD& hd = sky::atmosphere_hd(model);
+        const double R0 = a.planet_radius_km;
+        for (const double h : {0.0, 3.0, 25.0, 50.0, 60.0})
+            for (const double mu : {1.0, 0.3, 0.0, -0.05, -0.12, -0.5, -1.0}) {
+                const double want = sky::orders_scale(a, R0 + h, mu);
+                const float got = sky::orders_scale(hd, float(R0 + h), float(mu));
+                EXPECT_NEAR(got, want, 1e-4 * want + 1e-7) << h << " km, mu " << mu;
+                EXPECT_GT(want, 0.0);
+                EXPECT_LE(want, 1.0 + 1e-12);
+            }
+        // The zenith 50 km up: the density there relative to the ground's.
+        EXPECT_LT(sky::orders_scale(a, R0 + 50.0, 1.0), 0.01);
+        EXPECT_EQ(sky::orders_scale(a, R0 + 10.0, -0.9), 1.0); // meets the ground
+    }
+}
+
 TEST(ScatteringOrders, ThinAtmosphereSecondOrderIsSmall) {
     for (double scale : {1.0, 0.01}) {
         Atmosphere a = atmosphere_preset("earth");
