@@ -87,7 +87,7 @@ void add_sky_train(CLI::App& group) {
         ->capture_default_str();
     sub->add_option("--flight-share", o->t.flight_share,
                     "Share of the training samples drawn as a flight's (altitude uniform to 60 km, the sun down to "
-                    "-20 degrees) instead of uniformly (default: 0.3 with multiple scattering, else 0)")
+                    "-20 degrees) instead of uniformly (default: 0.4 with multiple scattering, else 0)")
         ->check(real_in(0.0, 1.0, ""));
     sub->add_option("--multiple-term", o->multiple_term,
                     "With --scattering multiple and residual outputs, the multiply scattered light: march (a "

@@ -316,7 +316,7 @@ struct NeuralTrainOptions {
     // This share of the training samples (after the hard ones) is drawn as a
     // flight's (draw_flight_samples: altitude uniform to 60 km, the sun down to
     // −20°), whose high, dim twilight the uniform samples barely reach. −1:
-    // automatic, 0.3 with multiple scattering (where it pays: docs/neural.md)
+    // automatic, 0.4 with multiple scattering (where it pays: docs/neural.md)
     // and 0 for single scattering (where it does not).
     double flight_share = -1.0;
     // Residual outputs with multiple scattering: the term as a correction of

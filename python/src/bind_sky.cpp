@@ -309,7 +309,7 @@ void bind_sky(py::module_& m) {
         "multiple of the atmosphere's, chosen at run time (NeuralSky.aerosol). hard_share: the share of training "
         "samples drawn near the horizon, the sun and the terminator (importance sampling; 0 by default). "
         "flight_share: the share drawn as a flight's, altitude uniform to 60 km and the sun down to -20 degrees "
-        "(None: 0.3 with multiple scattering, else 0). multiple_term: with multiple scattering, 'march' (a "
+        "(None: 0.4 with multiple scattering, else 0). multiple_term: with multiple scattering, 'march' (a "
         "correction of an isotropic march) or 'log' (log-encoded). The seed's network: topology='paper', inputs='seed', outputs='radiance', brightness='linear' "
         "(and table_rule='as-published', steps=16 for its targets). Deterministic for a seed. "
         "topology: 'paper' (324 weights), 'independent:16x16', 'shared:64x64', ...");

@@ -159,7 +159,7 @@ Atmosphere scaled_atmosphere(const NeuralEncoding& family, const Atmosphere& atm
 // m; `aerosol`, when not empty, holds each sample's aerosol amount (a family).
 MatF samples_to_matrix(const MlpHD& m, std::span<const SkySample> samples, std::span<const float> aerosol = {});
 // NeuralTrainOptions::flight_share, with its automatic value resolved.
-constexpr double kMultipleFlightShare = 0.3;
+constexpr double kMultipleFlightShare = 0.4;
 double effective_flight_share(const NeuralTrainOptions& options, const Atmosphere& atmosphere);
 
 // ln ψ's coefficients (NeuralEncoding::multiple_psi) for the model's sky:

@@ -314,7 +314,8 @@ ScatteringOrders ScatteringOrders::compute(const Atmosphere& atm, const Multiple
     // J is stored per unit of it (J / σs), which is smooth in altitude where
     // J itself falls with the density, e-fold by e-fold between the radius
     // nodes (7 km apart at the top, about one scale height): interpolated
-    // linearly, J was up to 12% too large between them.
+    // linearly, J was too large between them (alone, 4% of the light at
+    // the 50 km zenith 8° after sunset).
     const auto scattering_at = [&](double r) {
         glm::dvec3 s(0.0);
         for (std::size_t k = 0; k < K; ++k)
